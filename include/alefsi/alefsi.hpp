@@ -1,0 +1,8 @@
+#pragma once
+/// \file alefsi.hpp
+/// Everything: include this in applications and examples (tests include narrow headers).
+#include "alefsi/core.hpp"
+#include "alefsi/fem.hpp"
+#include "alefsi/la.hpp"
+#include "alefsi/mesh.hpp"
+#include "alefsi/physics.hpp"

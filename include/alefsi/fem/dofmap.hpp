@@ -1,0 +1,98 @@
+#pragma once
+/// \file fem/dofmap.hpp
+/// Global DOF numbering of scalar Lagrange spaces and of velocity/pressure spaces.
+///
+/// Scalar space (`DofMap<E, D>`): the DOF on mesh node v is v; the DOF on mesh edge e is
+/// n_nodes + e. Cell c's DOFs come in the element's local order.
+///
+/// Mixed space (`MixedSpace<D, Pair>`): the *field* vector holds every velocity component at
+/// every velocity DOF, interleaved (field index i*D + c for component c of scalar DOF i), then
+/// every pressure DOF (field index D*n_u + k). A cell's local field DOFs are ordered the same
+/// way: local velocity node a, component c -> a*D + c, then the pressure nodes.
+///
+///     alefsi::MixedSpace<2, alefsi::TaylorHood> space(mesh);
+///     auto dofs = space.cell_field_dofs(c);        // 15 field indices for a P2/P1 triangle
+///     Vec<2> x = space.velocity().point(i);        // where scalar velocity DOF i sits
+#include <array>
+#include <vector>
+
+#include "alefsi/fem/concepts.hpp"
+#include "alefsi/fem/element_pair.hpp"
+#include "alefsi/mesh/mesh.hpp"
+
+namespace alefsi {
+
+template <ScalarElement E, int D = E::dim>
+class DofMap {
+ public:
+  static constexpr int n_local = E::n_dofs;
+  using CellDofs = std::array<Index, n_local>;
+
+  explicit DofMap(const Mesh<D>& mesh) : mesh_(&mesh) {
+    n_dofs_ = mesh.n_nodes() + (E::n_edge_dofs > 0 ? mesh.n_edges() : 0);
+    cell_dofs_.resize(mesh.n_cells());
+    for (Index c = 0; c < mesh.n_cells(); ++c) {
+      for (int i = 0; i <= D; ++i) cell_dofs_[c][i] = mesh.cell(c)[i];
+      for (int e = 0; e < E::n_edge_dofs; ++e) cell_dofs_[c][D + 1 + e] = mesh.n_nodes() + mesh.cell_edges(c)[e];
+    }
+  }
+
+  Index n_dofs() const { return n_dofs_; }
+  const CellDofs& cell_dofs(Index c) const { return cell_dofs_[c]; }
+  /// Physical location of global DOF i (node, or midpoint of the straight edge).
+  Vec<D> point(Index i) const {
+    if (i < mesh_->n_nodes()) return mesh_->node(i);
+    const auto& e = mesh_->edge(i - mesh_->n_nodes());
+    return 0.5 * (mesh_->node(e[0]) + mesh_->node(e[1]));
+  }
+  /// Global DOFs on boundary facets with the given tag (sorted).
+  std::vector<Index> boundary_dofs(int tag) const {
+    std::vector<Index> out = mesh_->boundary_nodes(tag);
+    if constexpr (E::n_edge_dofs > 0)
+      for (Index e : mesh_->boundary_edges(tag)) out.push_back(mesh_->n_nodes() + e);
+    return out;
+  }
+  const Mesh<D>& mesh() const { return *mesh_; }
+
+ private:
+  const Mesh<D>* mesh_;
+  Index n_dofs_ = 0;
+  std::vector<CellDofs> cell_dofs_;
+};
+
+template <int D, ElementPair Pair>
+class MixedSpace {
+ public:
+  using VelocityElement = typename Pair::template Velocity<D>;
+  using PressureElement = typename Pair::template Pressure<D>;
+  static constexpr int dim = D;
+  static constexpr int n_velocity_local = VelocityElement::n_dofs;
+  static constexpr int n_pressure_local = PressureElement::n_dofs;
+  static constexpr int n_local = D * n_velocity_local + n_pressure_local;
+  using CellDofs = std::array<Index, n_local>;
+
+  explicit MixedSpace(const Mesh<D>& mesh) : velocity_(mesh), pressure_(mesh) {}
+
+  const Mesh<D>& mesh() const { return velocity_.mesh(); }
+  const DofMap<VelocityElement, D>& velocity() const { return velocity_; }
+  const DofMap<PressureElement, D>& pressure() const { return pressure_; }
+  Index n_field() const { return D * velocity_.n_dofs() + pressure_.n_dofs(); }
+  Index velocity_field(Index scalar_dof, int component) const { return D * scalar_dof + component; }
+  Index pressure_field(Index scalar_dof) const { return D * velocity_.n_dofs() + scalar_dof; }
+
+  CellDofs cell_field_dofs(Index c) const {
+    CellDofs out;
+    const auto& v = velocity_.cell_dofs(c);
+    for (int a = 0; a < n_velocity_local; ++a)
+      for (int k = 0; k < D; ++k) out[D * a + k] = velocity_field(v[a], k);
+    const auto& p = pressure_.cell_dofs(c);
+    for (int b = 0; b < n_pressure_local; ++b) out[D * n_velocity_local + b] = pressure_field(p[b]);
+    return out;
+  }
+
+ private:
+  DofMap<VelocityElement, D> velocity_;
+  DofMap<PressureElement, D> pressure_;
+};
+
+}  // namespace alefsi

@@ -1,0 +1,218 @@
+#pragma once
+/// \file physics/stokes.hpp
+/// Steady Stokes flow with Taylor–Hood (P2/P1) or P1/P1 + PSPG/GLS elements.
+///
+/// Weak form (mu: dynamic viscosity, f: body force per unit volume):
+///   find (u, p):  2 mu (D(u), D(v)) - (p, div v) - (q, div u)
+///                 - sum_K tau_K (grad p - mu lap u - f, grad q)_K = (f, v)   for all (v, q),
+/// where the last sum is present only for stabilised pairs (P1P1Gls; there lap u_h = 0 on each
+/// cell) with tau_K = h_K^2 / (c1 mu), c1 = 4, h_K = the longest edge of K (Codina 2001 with
+/// the convective and transient parts absent). The pressure block is then -C, C SPD, and the
+/// system is symmetric.
+///
+/// The residual form r(u) = A u - F is assembled at the current field (Dirichlet values
+/// included through `DofConstraints` offsets); one Newton step from any state solves the
+/// linear problem. When every boundary facet carries a Dirichlet condition the pressure is
+/// defined up to a constant: pressure DOF 0 is pinned to 0 during the solve and the computed
+/// pressure is then shifted to zero mean over the domain.
+///
+///     alefsi::Stokes<2, alefsi::TaylorHood> stokes(mesh, /*mu=*/1.0, f);
+///     for (int t : {1, 2, 3, 4}) stokes.set_velocity(t, u_exact);
+///     VecX field = stokes.solve();          // layout: see MixedSpace
+#include <cmath>
+#include <functional>
+#include <map>
+#include <vector>
+
+#include "alefsi/core/error.hpp"
+#include "alefsi/fem/constraints.hpp"
+#include "alefsi/fem/dofmap.hpp"
+#include "alefsi/fem/quadrature.hpp"
+#include "alefsi/la/assembler.hpp"
+#include "alefsi/la/solvers.hpp"
+
+namespace alefsi {
+
+template <int D>
+using VectorFunction = std::function<Vec<D>(const Vec<D>&)>;
+
+/// Element tables of a velocity/pressure pair at the points of a quadrature rule on the
+/// reference simplex (affine cells: physical gradients are reference gradients times J^-1).
+template <int D, ElementPair Pair>
+struct ReferenceTables {
+  using V = typename Pair::template Velocity<D>;
+  using P = typename Pair::template Pressure<D>;
+  explicit ReferenceTables(int degree) : rule(&simplex_quadrature<D>(degree)) {
+    for (int q = 0; q < rule->size(); ++q) {
+      phi_v.push_back(V::values(rule->points[q]));
+      dphi_v.push_back(V::gradients(rule->points[q]));
+      phi_p.push_back(P::values(rule->points[q]));
+      dphi_p.push_back(P::gradients(rule->points[q]));
+    }
+  }
+  const QuadratureRule<D>* rule;
+  std::vector<typename V::Values> phi_v;
+  std::vector<typename V::Gradients> dphi_v;
+  std::vector<typename P::Values> phi_p;
+  std::vector<typename P::Gradients> dphi_p;
+};
+
+template <int D, ElementPair Pair>
+class StokesKernel {
+ public:
+  using Space = MixedSpace<D, Pair>;
+  using V = typename Space::VelocityElement;
+  using P = typename Space::PressureElement;
+  static constexpr int nv = V::n_dofs, np = P::n_dofs, n_local = Space::n_local;
+  using LocalVec = Eigen::Matrix<Real, n_local, 1>;
+  using LocalMat = Eigen::Matrix<Real, n_local, n_local>;
+
+  /// `force` may be empty (no body force).
+  StokesKernel(const Space& space, Real mu, VectorFunction<D> force = {}, Real c1 = 4.0)
+      : space_(&space), mu_(mu), c1_(c1), f_(std::move(force)), tab_(2 * V::degree + 2) {
+    ALEFSI_CHECK_ARG(mu > 0 && std::isfinite(mu), "mu", "viscosity must be positive and finite, got ", mu);
+    ALEFSI_CHECK_ARG(c1 > 0, "c1", "GLS constant must be positive");
+  }
+
+  /// GLS/PSPG parameter of cell c (0 for stable pairs).
+  Real tau(Index c) const {
+    if constexpr (!Pair::stabilised) return 0;
+    const Real h = space_->mesh().diameter(c);
+    return h * h / (c1_ * mu_);
+  }
+
+  void cell(Index c, const LocalVec& u, LocalMat& A, LocalVec& r) const {
+    const auto& mesh = space_->mesh();
+    const Mat<D> J = mesh.jacobian(c);
+    const Mat<D> Jinv = J.inverse();
+    const Real detJ = J.determinant();
+    const Vec<D> x0 = mesh.node(mesh.cell(c)[0]);
+    const Real tau_c = tau(c);
+    A.setZero();
+    LocalVec F = LocalVec::Zero();
+    const auto& rule = *tab_.rule;
+    for (int q = 0; q < rule.size(); ++q) {
+      const Real w = rule.weights[q] * detJ;
+      const Eigen::Matrix<Real, nv, D> G = tab_.dphi_v[q] * Jinv;  // physical gradients
+      const auto& phv = tab_.phi_v[q];
+      const auto& php = tab_.phi_p[q];
+      for (int a = 0; a < nv; ++a)
+        for (int b = 0; b < nv; ++b) {
+          const Real gg = w * mu_ * G.row(a).dot(G.row(b));
+          for (int i = 0; i < D; ++i) {
+            A(D * a + i, D * b + i) += gg;
+            for (int j = 0; j < D; ++j) A(D * a + i, D * b + j) += w * mu_ * G(a, j) * G(b, i);
+          }
+        }
+      for (int a = 0; a < nv; ++a)
+        for (int b = 0; b < np; ++b)
+          for (int i = 0; i < D; ++i) {
+            const Real bdiv = -w * php[b] * G(a, i);
+            A(D * a + i, D * nv + b) += bdiv;
+            A(D * nv + b, D * a + i) += bdiv;
+          }
+      Vec<D> fq = Vec<D>::Zero();
+      if (f_) {
+        fq = f_(x0 + J * rule.points[q]);
+        for (int a = 0; a < nv; ++a)
+          for (int i = 0; i < D; ++i) F[D * a + i] += w * fq[i] * phv[a];
+      }
+      if constexpr (Pair::stabilised) {
+        const Eigen::Matrix<Real, np, D> Gp = tab_.dphi_p[q] * Jinv;
+        for (int a = 0; a < np; ++a) {
+          for (int b = 0; b < np; ++b) A(D * nv + a, D * nv + b) -= w * tau_c * Gp.row(a).dot(Gp.row(b));
+          F[D * nv + a] -= w * tau_c * fq.dot(Gp.row(a));
+        }
+      }
+    }
+    r = A * u - F;
+  }
+
+ private:
+  const Space* space_;
+  Real mu_, c1_;
+  VectorFunction<D> f_;
+  ReferenceTables<D, Pair> tab_;
+};
+
+/// A steady Stokes problem on a fixed mesh: Dirichlet conditions by boundary tag, then solve.
+template <int D, ElementPair Pair>
+class Stokes {
+ public:
+  using Space = MixedSpace<D, Pair>;
+  using Kernel = StokesKernel<D, Pair>;
+
+  Stokes(const Mesh<D>& mesh, Real mu, VectorFunction<D> force = {})
+      : space_(mesh), kernel_(space_, mu, std::move(force)) {}
+
+  /// Prescribes the velocity on the boundary facets with tag `tag`.
+  void set_velocity(int tag, VectorFunction<D> g) {
+    ALEFSI_CHECK_ARG(g != nullptr, "g", "boundary velocity function is empty");
+    ALEFSI_CHECK_ARG(!space_.velocity().boundary_dofs(tag).empty(), "tag", "no boundary facet has tag ", tag);
+    dirichlet_[tag] = std::move(g);
+  }
+
+  const Space& space() const { return space_; }
+  const Kernel& kernel() const { return kernel_; }
+  /// True when the pressure was fixed by pinning (all boundary velocities prescribed).
+  bool pressure_pinned() const { return pinned_; }
+
+  /// Assembles and solves; returns the field vector (velocity interleaved, then pressure).
+  template <LinearSolver Solver = SparseLu<>>
+  VecX solve(Solver solver = Solver{}) {
+    DofConstraints cons(space_.n_field());
+    const auto& vel = space_.velocity();
+    std::vector<char> done(vel.n_dofs(), 0);
+    for (const auto& [tag, g] : dirichlet_)
+      for (Index i : vel.boundary_dofs(tag)) {
+        if (done[i]) continue;
+        done[i] = 1;
+        const Vec<D> val = g(vel.point(i));
+        for (int k = 0; k < D; ++k) cons.fix(space_.velocity_field(i, k), val[k]);
+      }
+    pinned_ = true;
+    for (Index f : space_.mesh().boundary_facets()) pinned_ &= dirichlet_.count(space_.mesh().facet_tag(f)) > 0;
+    if (pinned_) cons.fix(space_.pressure_field(0), 0.0);
+    cons.finalize();
+    Assembler<Space::n_local> asmb(space_.mesh().n_cells(), [&](Index c) { return space_.cell_field_dofs(c); }, cons);
+    VecX field = cons.expand(VecX::Zero(cons.n_unknowns()));
+    SparseMatrix J;
+    VecX r;
+    asmb.assemble(kernel_, field, &J, &r);
+    solver.analyze(J);
+    solver.factorize(J);
+    const VecX du = solver.solve(-r);
+    field = cons.expand(du);
+    if (pinned_) shift_pressure_to_zero_mean(field);
+    return field;
+  }
+
+  /// Adds a constant to the pressure so that its mean over the domain is zero.
+  void shift_pressure_to_zero_mean(VecX& field) const {
+    using P = typename Space::PressureElement;
+    const auto& mesh = space_.mesh();
+    const auto& rule = simplex_quadrature<D>(P::degree);
+    Real integral = 0, volume = 0;
+    for (Index c = 0; c < mesh.n_cells(); ++c) {
+      const Real m = mesh.measure(c) / reference_measure<D>;
+      const auto& dofs = space_.pressure().cell_dofs(c);
+      for (int q = 0; q < rule.size(); ++q) {
+        const auto phi = P::values(rule.points[q]);
+        Real p = 0;
+        for (int b = 0; b < P::n_dofs; ++b) p += phi[b] * field[space_.pressure_field(dofs[b])];
+        integral += rule.weights[q] * m * p;
+      }
+      volume += mesh.measure(c);
+    }
+    const Real mean = integral / volume;
+    for (Index k = 0; k < space_.pressure().n_dofs(); ++k) field[space_.pressure_field(k)] -= mean;
+  }
+
+ private:
+  Space space_;
+  Kernel kernel_;
+  std::map<int, VectorFunction<D>> dirichlet_;
+  bool pinned_ = false;
+};
+
+}  // namespace alefsi

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# alefsi quick start on a fresh Debian 12 / Ubuntu 22.04+ machine.
+#   scripts/quickstart.sh example   installs what is missing, builds, runs the main example
+#   scripts/quickstart.sh test      installs what is missing, builds, runs the test suite
+# Installing needs root (or sudo). Build directory: build/release (CMake preset "release").
+set -euo pipefail
+mode=${1:-example}
+cd "$(dirname "$0")/.."
+
+packages=(cmake ninja-build g++ libeigen3-dev catch2 python3-vtk9 ccache)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "quickstart: installing ${missing[*]}"
+  sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo=sudo
+  $sudo apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+cmake --preset release
+case "$mode" in
+  example)
+    cmake --build --preset release --target stokes_couette
+    ./build/release/examples/stokes_couette --output build/release/output
+    ;;
+  test)
+    cmake --build --preset release
+    ctest --preset release
+    ;;
+  *)
+    echo "usage: $0 example|test" >&2
+    exit 2
+    ;;
+esac

@@ -1,0 +1,23 @@
+// 3D unit box [0,1]^3 with a spherical hole (centre (0.5,0.5,0.5), radius 0.25).
+SetFactory("OpenCASCADE");
+Box(1) = {0, 0, 0, 1, 1, 1};
+Sphere(2) = {0.5, 0.5, 0.5, 0.25};
+BooleanDifference(3) = { Volume{1}; Delete; }{ Volume{2}; Delete; };
+e = 1e-3;
+xmin() = Surface In BoundingBox{-e, -e, -e, e, 1 + e, 1 + e};
+xmax() = Surface In BoundingBox{1 - e, -e, -e, 1 + e, 1 + e, 1 + e};
+ymin() = Surface In BoundingBox{-e, -e, -e, 1 + e, e, 1 + e};
+ymax() = Surface In BoundingBox{-e, 1 - e, -e, 1 + e, 1 + e, 1 + e};
+zmin() = Surface In BoundingBox{-e, -e, -e, 1 + e, 1 + e, e};
+zmax() = Surface In BoundingBox{-e, -e, 1 - e, 1 + e, 1 + e, 1 + e};
+ball() = Surface In BoundingBox{0.25 - e, 0.25 - e, 0.25 - e, 0.75 + e, 0.75 + e, 0.75 + e};
+Physical Surface("xmin", 1) = xmin();
+Physical Surface("xmax", 2) = xmax();
+Physical Surface(3) = ymin();
+Physical Surface(4) = ymax();
+Physical Surface("zmin", 5) = zmin();
+Physical Surface("zmax", 6) = zmax();
+Physical Surface("sphere", 7) = ball();
+Physical Volume("solid", 20) = {3};
+Mesh.MeshSizeMax = 0.25;
+Mesh.MeshSizeFromCurvature = 12;

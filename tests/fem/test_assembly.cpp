@@ -1,0 +1,141 @@
+// DOF maps, the constraint-aware local-to-global map and the sparse assembler: the assembled
+// Jacobian and residual equal T^T (sum_c P_c^T A_c P_c) T computed densely, for free, fixed and
+// linked (rigid-body-like) DOFs.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <set>
+
+#include "alefsi/fem/constraints.hpp"
+#include "alefsi/fem/dofmap.hpp"
+#include "alefsi/la/assembler.hpp"
+#include "alefsi/mesh/generate/structured.hpp"
+
+using namespace alefsi;
+
+namespace {
+template <int N>
+struct PseudoRandomKernel {  // deterministic, cell-dependent, non-symmetric
+  void cell(Index c, const Eigen::Matrix<Real, N, 1>& u, Eigen::Matrix<Real, N, N>& A,
+            Eigen::Matrix<Real, N, 1>& r) const {
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) A(i, j) = std::sin(0.37 * c + 1.3 * i + 0.71 * j * j);
+    for (int i = 0; i < N; ++i) r[i] = std::cos(0.5 * c + i);
+    r += A * u;
+  }
+};
+}  // namespace
+
+TEST_CASE("DofMap numbers vertices then edges; MixedSpace interleaves velocity", "[fem][dofs][quick]") {
+  const auto mesh = rectangle_mesh(3, 2);
+  MixedSpace<2, TaylorHood> th(mesh);
+  CHECK(th.velocity().n_dofs() == mesh.n_nodes() + mesh.n_edges());
+  CHECK(th.pressure().n_dofs() == mesh.n_nodes());
+  CHECK(th.n_field() == 2 * (mesh.n_nodes() + mesh.n_edges()) + mesh.n_nodes());
+  for (Index c = 0; c < mesh.n_cells(); ++c) {
+    const auto& d = th.velocity().cell_dofs(c);
+    for (int e = 0; e < 3; ++e) {
+      // the P2 DOF point of local edge e is the midpoint of that edge's vertices
+      const auto& ab = SimplexTopology<2>::edges[e];
+      const Vec<2> mid = 0.5 * (mesh.node(mesh.cell(c)[ab[0]]) + mesh.node(mesh.cell(c)[ab[1]]));
+      CHECK((th.velocity().point(d[3 + e]) - mid).norm() < 1e-15);
+    }
+    const auto f = th.cell_field_dofs(c);
+    CHECK(f[2 * 4 + 1] == 2 * d[4] + 1);
+    CHECK(f[12] == th.pressure_field(mesh.cell(c)[0]));
+  }
+  // boundary DOFs of the top side: 4 nodes + 3 edges
+  CHECK(th.velocity().boundary_dofs(tags::top).size() == 7);
+}
+
+TEST_CASE("constraints: expand, reduce and invalid use", "[fem][constraints][quick]") {
+  DofConstraints c(5);
+  const Index z = c.add_unknowns(2);
+  c.fix(1, 3.0);
+  const Index ex[] = {z, z + 1};
+  const Real w[] = {2.0, -1.0};
+  c.link(3, ex, w, 0.5);
+  REQUIRE_THROWS_AS(c.fix(1, 0.0), InvalidArgument);  // already constrained
+  REQUIRE_THROWS_AS(c.fix(9, 0.0), InvalidArgument);  // out of range
+  REQUIRE_THROWS_AS(c.expand(VecX::Zero(5)), Error);   // before finalize
+  c.finalize();
+  CHECK(c.n_free() == 3);
+  CHECK(c.n_unknowns() == 5);
+  VecX u(5);
+  u << 1, 2, 3, 10, 20;  // free DOFs 0, 2, 4 then extras
+  const VecX f = c.expand(u);
+  CHECK(f[0] == 1);
+  CHECK(f[1] == 3.0);
+  CHECK(f[2] == 2);
+  CHECK(f[3] == Approx(2 * 10 - 20 + 0.5));
+  CHECK(f[4] == 3);
+  VecX rf(5);
+  rf << 1, 1, 1, 1, 1;
+  const VecX ru = c.reduce(rf);
+  CHECK(ru[3] == 2.0);
+  CHECK(ru[4] == -1.0);
+  REQUIRE_THROWS_AS(c.add_unknowns(1), Error);  // structure is frozen
+}
+
+TEMPLATE_TEST_CASE("assembly equals the dense T^T A T for free, fixed and linked DOFs", "[la][assembly][quick]",
+                   TaylorHood, P1P1Gls) {
+  const auto mesh = annulus_mesh(0.3, 1.0, 3, 16);
+  using Space = MixedSpace<2, TestType>;
+  Space space(mesh);
+  DofConstraints cons(space.n_field());
+  // outer wall fixed, inner circle linked to a "rigid body" Z = (V1, V2, w): u = V + w x r
+  const Index z = cons.add_unknowns(3);
+  for (Index i : space.velocity().boundary_dofs(tags::outer))
+    for (int k = 0; k < 2; ++k) cons.fix(space.velocity_field(i, k), 0.1 * (k + 1));
+  for (Index i : space.velocity().boundary_dofs(tags::inner)) {
+    const Vec<2> x = space.velocity().point(i);
+    const Index ex[] = {z, z + 1, z + 2};
+    const Real w0[] = {1.0, 0.0, -x[1]}, w1[] = {0.0, 1.0, x[0]};
+    cons.link(space.velocity_field(i, 0), ex, w0, 0.01);
+    cons.link(space.velocity_field(i, 1), ex, w1, -0.02);
+  }
+  cons.fix(space.pressure_field(0), 0.0);
+  cons.finalize();
+  Assembler<Space::n_local> asmb(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
+  CHECK(asmb.n_linked_cells() > 0);
+
+  VecX field(space.n_field());
+  for (Index f = 0; f < field.size(); ++f) field[f] = std::sin(1.7 * f);
+  PseudoRandomKernel<Space::n_local> k;
+  SparseMatrix J;
+  VecX r;
+  asmb.assemble(k, field, &J, &r);
+
+  // dense reference
+  const Index nf = space.n_field(), nu = cons.n_unknowns();
+  MatX T = MatX::Zero(nf, nu), Af = MatX::Zero(nf, nf);
+  VecX rf = VecX::Zero(nf);
+  for (Index f = 0; f < nf; ++f)
+    for (std::size_t e = 0; e < cons.indices(f).size(); ++e) T(f, cons.indices(f)[e]) = cons.weights(f)[e];
+  for (Index c = 0; c < mesh.n_cells(); ++c) {
+    const auto d = space.cell_field_dofs(c);
+    typename Assembler<Space::n_local>::LocalMat A;
+    typename Assembler<Space::n_local>::LocalVec re;
+    k.cell(c, asmb.gather(c, field), A, re);
+    for (int i = 0; i < Space::n_local; ++i) {
+      rf[d[i]] += re[i];
+      for (int j = 0; j < Space::n_local; ++j) Af(d[i], d[j]) += A(i, j);
+    }
+  }
+  const MatX Jref = T.transpose() * Af * T;
+  const VecX rref = T.transpose() * rf;
+  const MatX Jd = MatX(J);
+  CHECK((Jd - Jref).norm() <= 1e-12 * Jref.norm());
+  CHECK((r - rref).norm() <= 1e-12 * rref.norm());
+  // the pattern holds every nonzero of the reference and its row indices are sorted
+  for (Index col = 0; col < nu; ++col) {
+    for (Index p = J.outerIndexPtr()[col] + 1; p < J.outerIndexPtr()[col + 1]; ++p)
+      CHECK(J.innerIndexPtr()[p] > J.innerIndexPtr()[p - 1]);
+    for (Index row = 0; row < nu; ++row)
+      if (std::abs(Jref(row, col)) > 1e-14) CHECK(J.coeff(row, col) != 0.0);
+  }
+  // assembling twice gives the same values (the matrix is reset, not accumulated)
+  SparseMatrix J2 = J;
+  asmb.assemble(k, field, &J2, nullptr);
+  CHECK((MatX(J2) - Jd).norm() == 0.0);
+}

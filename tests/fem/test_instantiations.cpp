@@ -1,0 +1,37 @@
+// Explicit instantiation of the curated configurations, so that member functions no test
+// calls still compile (deal.II .inst.in style). Adding a configuration here is how a new
+// combination becomes supported.
+#include <catch2/catch.hpp>
+
+#include "alefsi/fem/dofmap.hpp"
+#include "alefsi/la/assembler.hpp"
+#include "alefsi/la/solvers.hpp"
+#include "alefsi/mesh/mesh.hpp"
+#include "alefsi/physics/stokes.hpp"
+
+namespace alefsi {
+template class Mesh<2>;
+template class Mesh<3>;
+template class DofMap<Lagrange<2, 1>>;
+template class DofMap<Lagrange<2, 2>>;
+template class DofMap<Lagrange<3, 1>>;
+template class DofMap<Lagrange<3, 2>>;
+template class MixedSpace<2, TaylorHood>;
+template class MixedSpace<2, P1P1Gls>;
+template class MixedSpace<3, TaylorHood>;
+template class MixedSpace<3, P1P1Gls>;
+template class StokesKernel<2, TaylorHood>;
+template class StokesKernel<2, P1P1Gls>;
+template class StokesKernel<3, TaylorHood>;
+template class StokesKernel<3, P1P1Gls>;
+template class Stokes<2, TaylorHood>;
+template class Stokes<2, P1P1Gls>;
+template class Stokes<3, TaylorHood>;
+template class Stokes<3, P1P1Gls>;
+template VecX Stokes<2, TaylorHood>::solve<SparseLu<>>(SparseLu<>);
+template VecX Stokes<3, P1P1Gls>::solve<BiCgStabIlut>(BiCgStabIlut);
+template class SparseLu<>;
+template class SparseLu<Eigen::AMDOrdering<Index>>;
+}  // namespace alefsi
+
+TEST_CASE("curated configurations instantiate", "[fem][quick]") { SUCCEED("compiled"); }

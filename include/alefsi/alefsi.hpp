@@ -6,3 +6,5 @@
 #include "alefsi/la.hpp"
 #include "alefsi/mesh.hpp"
 #include "alefsi/physics.hpp"
+#include "alefsi/sim.hpp"
+#include "alefsi/time.hpp"

@@ -1,4 +1,6 @@
 #pragma once
 /// \file physics.hpp
-/// The physics module: flow kernels.
+/// The physics module: Stokes and ALE Navier-Stokes kernels, mesh motion.
+#include "alefsi/physics/mesh_motion.hpp"
+#include "alefsi/physics/navier_stokes.hpp"
 #include "alefsi/physics/stokes.hpp"

@@ -8,6 +8,7 @@
 #include "alefsi/la/solvers.hpp"
 #include "alefsi/mesh/mesh.hpp"
 #include "alefsi/physics/stokes.hpp"
+#include "alefsi/sim/ale_flow.hpp"
 
 namespace alefsi {
 template class Mesh<2>;
@@ -31,6 +32,14 @@ template class Stokes<3, P1P1Gls>;
 template VecX Stokes<2, TaylorHood>::solve<SparseLu<>>(SparseLu<>);
 template VecX Stokes<3, P1P1Gls>::solve<BiCgStabIlut>(BiCgStabIlut);
 template class SparseLu<>;
+template class ElasticMeshMotion<2>;
+template class ElasticMeshMotion<3>;
+template class AleNavierStokesKernel<2, TaylorHood>;
+template class AleNavierStokesKernel<2, P1P1Gls>;
+template class AleNavierStokesKernel<3, TaylorHood, false>;
+template class AleFlow<2, TaylorHood, BDF3_BDF3E>;
+template class AleFlow<2, P1P1Gls, BDF2_BDF2E>;
+template class AleFlow<3, TaylorHood, MR_AB, false>;
 template class SparseLu<Eigen::AMDOrdering<Index>>;
 }  // namespace alefsi
 

@@ -1,0 +1,136 @@
+#pragma once
+/// \file physics/mesh_motion.hpp
+/// Mesh velocity from the elasticity problem of eq. (15)-(16).
+///
+/// Find the nodal mesh velocity v (P1, one vector per mesh node) with v given on every
+/// boundary node and
+///     int_Omega [ lambda_e (div v) I + 2 mu_e D(v) ] : D(w) = 0   for all w vanishing there,
+/// with element-wise constants mu_e = 1/|K| (stiffer small cells) and
+///     2D: lambda_e = -mu_e (the paper's choice). Then 2 D(v):D(v) - (div v)^2 =
+///         (v1,x - v2,y)^2 + (v1,y + v2,x)^2 >= 0: a conformal energy, SPD with Dirichlet data;
+///     3D: lambda_e = 0. With lambda = -mu the 3D integrand is indefinite (D v = I gives
+///         6 - 9 < 0), and with mu jumping between cells nothing guarantees a definite system
+///         (DESIGN.md); lambda = 0 keeps it SPD.
+/// The geometry is the one passed to `solve` (the scheme's extrapolated positions), not the
+/// mesh's current coordinates. The sparsity pattern and the symbolic Cholesky analysis are
+/// done once per mesh topology; each solve assembles and factorises numerically.
+///
+///     ElasticMeshMotion<2> motion(mesh);
+///     auto v = motion.solve(X_hat, [&](Index node, const Vec<2>& x) { return wall_velocity(x); });
+#include <array>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "alefsi/core/eigen_sparse.hpp"
+#include "alefsi/fem/constraints.hpp"
+#include "alefsi/la/assembler.hpp"
+#include "alefsi/mesh/mesh.hpp"
+
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wall"
+#pragma GCC diagnostic ignored "-Wextra"
+#endif
+#include <Eigen/SparseCholesky>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+
+namespace alefsi {
+
+template <int D>
+class ElasticMeshMotion {
+ public:
+  static constexpr int n_local = D * (D + 1);
+  using BoundaryData = std::function<Vec<D>(Index node, const Vec<D>& x)>;
+
+  explicit ElasticMeshMotion(const Mesh<D>& mesh) : mesh_(&mesh), cons_(D * mesh.n_nodes()) {
+    std::vector<char> on_boundary(mesh.n_nodes(), 0);
+    for (Index f : mesh.boundary_facets())
+      for (Index v : mesh.facet(f)) on_boundary[v] = 1;
+    for (Index v = 0; v < mesh.n_nodes(); ++v)
+      if (on_boundary[v]) {
+        boundary_.push_back(v);
+        for (int k = 0; k < D; ++k) cons_.fix(D * v + k, 0.0);
+      }
+    cons_.finalize();
+    asmb_ = std::make_unique<Assembler<n_local>>(
+        mesh.n_cells(),
+        [&](Index c) {
+          std::array<Index, n_local> d;
+          for (int a = 0; a <= D; ++a)
+            for (int k = 0; k < D; ++k) d[D * a + k] = D * mesh.cell(c)[a] + k;
+          return d;
+        },
+        cons_);
+  }
+
+  /// Nodes whose mesh velocity is prescribed (every boundary node).
+  const std::vector<Index>& boundary_nodes() const { return boundary_; }
+
+  /// Solves on the geometry `x` (one position per node) with boundary velocities from `g`.
+  std::vector<Vec<D>> solve(const std::vector<Vec<D>>& x, const BoundaryData& g) {
+    for (Index v : boundary_) {
+      const Vec<D> val = g(v, x[v]);
+      for (int k = 0; k < D; ++k) cons_.set_fixed_value(D * v + k, val[k]);
+    }
+    std::vector<Vec<D>> out(x.size());
+    if (cons_.n_unknowns() == 0) {
+      for (Index v : boundary_) out[v] = g(v, x[v]);
+      return out;
+    }
+    Kernel k{mesh_, &x};
+    const VecX field0 = cons_.expand(VecX::Zero(cons_.n_unknowns()));
+    VecX r;
+    asmb_->assemble(k, field0, &J_, &r);
+    if (!analysed_) {
+      llt_.analyzePattern(J_);
+      analysed_ = true;
+    }
+    llt_.factorize(J_);
+    if (llt_.info() != Eigen::Success)
+      throw SolverError("mesh-velocity (elasticity) matrix is not positive definite: is the extrapolated mesh valid?");
+    const VecX field = cons_.expand(llt_.solve(-r));
+    for (std::size_t v = 0; v < x.size(); ++v)
+      for (int kk = 0; kk < D; ++kk) out[v][kk] = field[D * Index(v) + kk];
+    return out;
+  }
+
+ private:
+  struct Kernel {
+    const Mesh<D>* mesh;
+    const std::vector<Vec<D>>* x;
+    void cell(Index c, const Eigen::Matrix<Real, n_local, 1>& u, Eigen::Matrix<Real, n_local, n_local>& A,
+              Eigen::Matrix<Real, n_local, 1>& r) const {
+      const auto& cv = mesh->cell(c);
+      Mat<D> J;
+      for (int i = 0; i < D; ++i) J.col(i) = (*x)[cv[i + 1]] - (*x)[cv[0]];
+      const Real vol = std::abs(J.determinant()) * reference_measure<D>;
+      const Mat<D> Jinv = J.inverse();
+      Eigen::Matrix<Real, D + 1, D> G;  // gradients of the P1 basis
+      G.row(0) = -Jinv.colwise().sum();
+      G.bottomRows(D) = Jinv;
+      const Real mu = 1.0 / vol, lambda = D == 2 ? -mu : 0.0;
+      for (int a = 0; a <= D; ++a)
+        for (int b = 0; b <= D; ++b) {
+          const Real gg = G.row(a).dot(G.row(b));
+          for (int i = 0; i < D; ++i)
+            for (int j = 0; j < D; ++j)
+              A(D * a + i, D * b + j) =
+                  vol * (lambda * G(a, i) * G(b, j) + mu * ((i == j ? gg : 0.0) + G(a, j) * G(b, i)));
+        }
+      r = A * u;
+    }
+  };
+
+  const Mesh<D>* mesh_;
+  DofConstraints cons_;
+  std::vector<Index> boundary_;
+  std::unique_ptr<Assembler<n_local>> asmb_;
+  SparseMatrix J_;
+  Eigen::SimplicialLLT<SparseMatrix> llt_;
+  bool analysed_ = false;
+};
+
+}  // namespace alefsi

@@ -1,0 +1,298 @@
+#pragma once
+/// \file sim/ale_flow.hpp
+/// Incompressible flow on a moving mesh, advanced by one of the five ALE schemes.
+///
+/// `AleFlow<D, Pair, Scheme, Convection>` owns the mesh and the time histories (positions X,
+/// velocities U, the mesh velocity V^n) and advances them, one `step(dt)` at a time, exactly as
+/// section 4 of the paper prescribes (see time/schemes.hpp for the table):
+///   1. X^ = sum_k e_k X^{n-k}, U^ likewise (the scheme's extrapolation);
+///   2. the mesh velocity at the scheme's level, on X^: from the elasticity problem with the
+///      boundary mesh velocities (`set_mesh_velocity`, default 0), or from an analytic field
+///      (`set_prescribed_mesh_velocity`, for verification);
+///   3. X^{n+1} from delta_lg X^{n+1} = dt V;
+///   4. the flow at n+theta on X^{n+theta} (physics/navier_stokes.hpp): Newton with the exact
+///      Jacobian until the residual drops below the tolerance, or one semi-implicit linear solve.
+/// Dirichlet velocities (`set_velocity`) are imposed at t^{n+1} on the DOF positions of X^{n+1}.
+/// When every boundary facet has a Dirichlet velocity, pressure DOF 0 is pinned and the pressure
+/// shifted to zero mean after each step (as in physics/stokes.hpp).
+///
+/// Start-up: a scheme that reads past levels the history does not have yet takes MR/AB steps
+/// (self-starting, local error O(dt^3), so BDF3 keeps its order); the very first MR/AB step
+/// takes X^{-1} = X^0 - dt V^0 with V^0 solved on X^0, and U^{-1} = U^0.
+///
+///     AleFlow<2, TaylorHood, BDF3_BDF3E> flow(mesh, {.rho = 1, .mu = 0.01});
+///     flow.set_velocity(tags::top, [](const Vec<2>& x, Real t) { ... });
+///     flow.set_initial_velocity(u0);
+///     for (int n = 0; n < 100; ++n) flow.step(0.01);
+#include <array>
+#include <functional>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "alefsi/core/error.hpp"
+#include "alefsi/fem/constraints.hpp"
+#include "alefsi/fem/dofmap.hpp"
+#include "alefsi/la/assembler.hpp"
+#include "alefsi/la/solvers.hpp"
+#include "alefsi/mesh/mesh.hpp"
+#include "alefsi/physics/mesh_motion.hpp"
+#include "alefsi/physics/navier_stokes.hpp"
+#include "alefsi/time/schemes.hpp"
+
+namespace alefsi {
+
+struct FlowOptions {
+  Real rho = 1, mu = 1;
+  Linearisation linearisation = Linearisation::newton;
+  int max_newton = 25;
+  Real newton_tolerance = 1e-10;  ///< on the residual's max norm, relative to its first value (+ absolute 1e-13)
+};
+
+struct StepReport {
+  int newton_iterations = 0;
+  std::vector<Real> residuals;  ///< max-norm residual before each Newton update
+  bool startup = false;
+};
+
+template <int D, ElementPair Pair, TimeScheme Scheme, bool Convection = true, LinearSolver Solver = SparseLu<>>
+class AleFlow {
+ public:
+  using Space = MixedSpace<D, Pair>;
+  using Kernel = AleNavierStokesKernel<D, Pair, Convection>;
+  using TimeFunction = std::function<Vec<D>(const Vec<D>&, Real)>;
+
+  AleFlow(Mesh<D> mesh, FlowOptions opt)
+      : mesh_(std::move(mesh)), opt_(opt), space_(mesh_), kernel_(space_, opt.rho, opt.mu, opt.linearisation),
+        motion_(mesh_) {
+    ALEFSI_CHECK_ARG(opt.max_newton >= 1, "max_newton", "must be >= 1");
+    X_[0] = mesh_.coordinates();
+    U_[0] = VecX::Zero(space_.n_field());
+  }
+
+  AleFlow(const AleFlow&) = delete;  // the space and kernels point into the owned mesh
+  AleFlow& operator=(const AleFlow&) = delete;
+
+  const Mesh<D>& mesh() const { return mesh_; }
+  const Space& space() const { return space_; }
+  Real time() const { return t_; }
+  /// u^n and p^n (p at the scheme's level n - 1 + theta) as a field vector.
+  const VecX& field() const { return U_[0]; }
+  /// Mesh velocity at level n (per node).
+  const std::vector<Vec<D>>& mesh_velocity() const { return Vn_; }
+
+  void set_velocity(int tag, TimeFunction g) {
+    require_not_started("set_velocity");
+    ALEFSI_CHECK_ARG(g != nullptr, "g", "boundary velocity function is empty");
+    ALEFSI_CHECK_ARG(!space_.velocity().boundary_dofs(tag).empty(), "tag", "no boundary facet has tag ", tag);
+    dirichlet_[tag] = std::move(g);
+  }
+  void set_mesh_velocity(int tag, TimeFunction g) {
+    ALEFSI_CHECK_ARG(!mesh_.boundary_nodes(tag).empty(), "tag", "no boundary facet has tag ", tag);
+    mesh_bc_[tag] = std::move(g);
+  }
+  void set_prescribed_mesh_velocity(TimeFunction v) { prescribed_ = std::move(v); }
+  void set_force(TimeFunction f) { force_ = std::move(f); }
+  void set_initial_velocity(const std::function<Vec<D>(const Vec<D>&)>& u0, Real t0 = 0) {
+    require_not_started("set_initial_velocity");
+    t_ = t0;
+    for (Index i = 0; i < space_.velocity().n_dofs(); ++i) {
+      const Vec<D> val = u0(space_.velocity().point(i));
+      for (int k = 0; k < D; ++k) U_[0][space_.velocity_field(i, k)] = val[k];
+    }
+  }
+
+  /// Advances from t^n to t^n + dt.
+  StepReport step(Real dt) {
+    ALEFSI_CHECK_ARG(dt > 0 && std::isfinite(dt), "dt", "time step must be positive and finite, got ", dt);
+    if (!cons_) setup();
+    if (levels_ == 0) Vn_ = solve_mesh_velocity(X_[0], U_[0], t_);
+    StepReport rep;
+    if (levels_ < history_levels<Scheme>()) {
+      rep = step_with<MR_AB>(dt);
+      rep.startup = true;
+    } else {
+      rep = step_with<Scheme>(dt);
+    }
+    return rep;
+  }
+
+ private:
+  void require_not_started(const char* what) const {
+    if (cons_) throw Error(std::string("AleFlow::") + what + " after the first step");
+  }
+
+  void setup() {
+    cons_ = std::make_unique<DofConstraints>(space_.n_field());
+    const auto& vel = space_.velocity();
+    std::vector<char> done(vel.n_dofs(), 0);
+    for (const auto& [tag, g] : dirichlet_)
+      for (Index i : vel.boundary_dofs(tag)) {
+        if (done[i]) continue;
+        done[i] = 1;
+        dirichlet_dofs_.push_back({i, tag});
+        for (int k = 0; k < D; ++k) cons_->fix(space_.velocity_field(i, k), 0.0);
+      }
+    pinned_ = true;
+    for (Index f : mesh_.boundary_facets()) pinned_ &= dirichlet_.count(mesh_.facet_tag(f)) > 0;
+    if (pinned_) cons_->fix(space_.pressure_field(0), 0.0);
+    cons_->finalize();
+    asmb_ = std::make_unique<Assembler<Space::n_local>>(
+        mesh_.n_cells(), [&](Index c) { return space_.cell_field_dofs(c); }, *cons_);
+  }
+
+  // DOF position of scalar velocity DOF i on geometry x.
+  Vec<D> dof_point(Index i, const std::vector<Vec<D>>& x) const {
+    if (i < mesh_.n_nodes()) return x[i];
+    const auto& e = mesh_.edge(i - mesh_.n_nodes());
+    return 0.5 * (x[e[0]] + x[e[1]]);
+  }
+
+  std::vector<Vec<D>> solve_mesh_velocity(const std::vector<Vec<D>>& x, const VecX& /*u_hat*/, Real t) {
+    if (prescribed_) {
+      std::vector<Vec<D>> v(x.size());
+      for (std::size_t i = 0; i < x.size(); ++i) v[i] = prescribed_(x[i], t);
+      return v;
+    }
+    // boundary data: the tag's function, 0 elsewhere
+    std::vector<const TimeFunction*> node_fn(mesh_.n_nodes(), nullptr);
+    for (const auto& [tag, g] : mesh_bc_)
+      for (Index v : mesh_.boundary_nodes(tag)) node_fn[v] = &g;
+    return motion_.solve(x, [&](Index v, const Vec<D>& xv) { return node_fn[v] ? (*node_fn[v])(xv, t) : Vec<D>(Vec<D>::Zero()); });
+  }
+
+  template <TimeScheme S>
+  StepReport step_with(Real dt) {
+    // the first MR/AB step: X^{-1} = X^0 - dt V^0, U^{-1} = U^0
+    if (levels_ == 0 && history_levels<S>() > 0) {
+      X_[1] = X_[0];
+      for (std::size_t i = 0; i < X_[1].size(); ++i) X_[1][i] -= dt * Vn_[i];
+      U_[1] = U_[0];
+    }
+    // 1. extrapolated geometry and flow
+    std::vector<Vec<D>> Xh(X_[0].size(), Vec<D>::Zero());
+    VecX Uh = VecX::Zero(U_[0].size());
+    for (int k = 0; k < 3; ++k)
+      if (S::extrapolation[k] != 0) {
+        for (std::size_t i = 0; i < Xh.size(); ++i) Xh[i] += S::extrapolation[k] * X_[k][i];
+        Uh += S::extrapolation[k] * U_[k];
+      }
+    // 2. mesh velocity
+    const Real tV = S::velocity_level == VelocityLevel::n ? t_ : S::velocity_level == VelocityLevel::n_half ? t_ + dt / 2 : t_ + dt;
+    const std::vector<Vec<D>> Vs = solve_mesh_velocity(Xh, Uh, tV);
+    // 3. positions
+    const auto b = bdf_coefficients(S::position_bdf);
+    std::vector<Vec<D>> Xn1(X_[0].size());
+    for (std::size_t i = 0; i < Xn1.size(); ++i) {
+      Vec<D> s = dt * Vs[i];
+      for (int k = 1; k <= S::position_bdf; ++k) s -= b[k] * X_[k - 1][i];
+      Xn1[i] = s / b[0];
+    }
+    // mesh velocity the flow sees, and V^{n+1} for the next step
+    std::vector<Vec<D>> Vflow = Vs, Vnext = Vs;
+    if (S::velocity_level == VelocityLevel::n_half)
+      for (std::size_t i = 0; i < Vs.size(); ++i) Vnext[i] = 2 * Vs[i] - Vn_[i];
+    if (S::flow_velocity == FlowMeshVelocity::ab2) Vflow = Vnext;
+    // 4. flow geometry X^{n+theta}
+    std::vector<Vec<D>> Xth(Xn1.size());
+    for (std::size_t i = 0; i < Xth.size(); ++i) Xth[i] = S::theta * Xn1[i] + (1 - S::theta) * X_[0][i];
+    mesh_.set_coordinates(Xth);
+    // Dirichlet values at t^{n+1} on X^{n+1}
+    const Real t1 = t_ + dt;
+    for (const auto& [i, tag] : dirichlet_dofs_) {
+      const Vec<D> val = dirichlet_.at(tag)(dof_point(i, Xn1), t1);
+      for (int k = 0; k < D; ++k) cons_->set_fixed_value(space_.velocity_field(i, k), val[k]);
+    }
+    // history of the BDF time derivative and the extrapolated convecting velocity
+    const auto a = bdf_coefficients(S::flow_bdf);
+    VecX hist = VecX::Zero(U_[0].size());
+    for (int k = 1; k <= S::flow_bdf; ++k) hist += a[k] * U_[k - 1];
+    const auto ew = extrapolation_weights(S::theta < 1 ? 2 : S::flow_bdf, S::theta < 1);
+    VecX ustar = VecX::Zero(U_[0].size());
+    for (int k = 0; k < 3; ++k)
+      if (ew[k] != 0) ustar += ew[k] * U_[k];
+    StepInputs<D> in;
+    in.dt = dt;
+    in.theta = S::theta;
+    in.a0 = a[0];
+    in.history = &hist;
+    in.previous = &U_[0];
+    in.extrapolated = &ustar;
+    in.mesh_velocity = &Vflow;
+    const Real tf = t_ + S::theta * dt;
+    if (force_) in.force = [this, tf](const Vec<D>& x) { return force_(x, tf); };
+    kernel_.set_step(in);
+    // 5. Newton (or one semi-implicit solve)
+    StepReport rep;
+    VecX u = cons_->restrict_free(U_[0]);
+    VecX field = cons_->expand(u);
+    VecX r;
+    Real r0 = -1;
+    const int iters = opt_.linearisation == Linearisation::newton ? opt_.max_newton : 1;
+    for (int it = 0; it < iters; ++it) {
+      asmb_->assemble(kernel_, field, &J_, &r);
+      const Real rn = r.size() ? r.lpNorm<Eigen::Infinity>() : 0.0;
+      rep.residuals.push_back(rn);
+      if (r0 < 0) r0 = rn;
+      if (opt_.linearisation == Linearisation::newton && it > 0 && rn <= opt_.newton_tolerance * r0 + 1e-13) break;
+      if (!analysed_) {
+        solver_.analyze(J_);
+        analysed_ = true;
+      }
+      solver_.factorize(J_);
+      u -= solver_.solve(r);
+      field = cons_->expand(u);
+      ++rep.newton_iterations;
+      if (opt_.linearisation == Linearisation::newton && it + 1 == iters)
+        throw SolverError("Newton did not converge in " + std::to_string(iters) + " iterations (residual " +
+                          std::to_string(rn) + ")");
+    }
+    if (pinned_) shift_pressure(field);
+    // 6. shift histories
+    U_[2] = U_[1];
+    U_[1] = U_[0];
+    U_[0] = field;
+    X_[2] = X_[1];
+    X_[1] = X_[0];
+    X_[0] = Xn1;
+    Vn_ = Vnext;
+    mesh_.set_coordinates(Xn1);
+    t_ = t1;
+    ++levels_;
+    return rep;
+  }
+
+  void shift_pressure(VecX& field) const {
+    Real integral = 0, volume = 0;
+    for (Index c = 0; c < mesh_.n_cells(); ++c) {
+      const auto& pd = space_.pressure().cell_dofs(c);
+      Real mean = 0;  // P1/P2 pressure: the vertex mean integrates P1 exactly
+      for (int b = 0; b <= D; ++b) mean += field[space_.pressure_field(pd[b])];
+      integral += mesh_.measure(c) * mean / (D + 1);
+      volume += mesh_.measure(c);
+    }
+    const Real m = integral / volume;
+    for (Index k = 0; k < space_.pressure().n_dofs(); ++k) field[space_.pressure_field(k)] -= m;
+  }
+
+  Mesh<D> mesh_;
+  FlowOptions opt_;
+  Space space_;
+  Kernel kernel_;
+  ElasticMeshMotion<D> motion_;
+  std::map<int, TimeFunction> dirichlet_, mesh_bc_;
+  TimeFunction prescribed_, force_;
+  std::vector<std::pair<Index, int>> dirichlet_dofs_;
+  std::unique_ptr<DofConstraints> cons_;
+  std::unique_ptr<Assembler<Space::n_local>> asmb_;
+  SparseMatrix J_;
+  Solver solver_;
+  bool analysed_ = false, pinned_ = false;
+  Real t_ = 0;
+  int levels_ = 0;  // steps taken (history levels available)
+  std::array<std::vector<Vec<D>>, 3> X_;
+  std::array<VecX, 3> U_;
+  std::vector<Vec<D>> Vn_;
+};
+
+}  // namespace alefsi

@@ -1,0 +1,4 @@
+#pragma once
+/// \file time.hpp
+/// The time module: the ALE schemes as types.
+#include "alefsi/time/schemes.hpp"

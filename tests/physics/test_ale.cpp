@@ -194,3 +194,63 @@ TEMPLATE_TEST_CASE("2D P1/P1-GLS: every scheme reaches at least its design order
 TEMPLATE_TEST_CASE("3D Taylor-Hood: design order in time", "[ale][convergence]", BDF2_BDF2E, BDF3_BDF3E) {
   check_order<3, TaylorHood, TestType>(false, {10, 20, 40, 80}, 1.0, 2);
 }
+
+TEMPLATE_TEST_CASE("semi-implicit (extrapolated convection, one solve per step) keeps the design order",
+                   "[ale][convergence]", MR_AB, BDF2_BDF2E, BDF3_BDF3E, BSS) {
+  std::vector<int> steps{10, 20, 40, 80};
+  std::vector<Real> err;
+  for (int s : steps) err.push_back(run_mms<2, TaylorHood, TestType>(s, 1.0, false, 4, Linearisation::semi_implicit));
+  std::cout << "2D P2/P1 " << TestType::name << " semi-implicit:";
+  for (std::size_t k = 0; k < err.size(); ++k) std::cout << " " << err[k];
+  const Real rate = std::log(err[2] / err[3]) / std::log(2.0);
+  std::cout << "  rate " << rate << "\n";
+  CHECK(rate == Approx(TestType::order).margin(0.15));
+}
+
+namespace {
+// Kovasznay flow (steady Navier-Stokes), Re = rho / mu = 40 on [-0.5, 1] x [-0.5, 1.5].
+constexpr Real kov_re = 40;
+inline Real kov_lambda() { return kov_re / 2 - std::sqrt(kov_re * kov_re / 4 + 4 * pi * pi); }
+Vec<2> kov_u(const Vec<2>& x) {
+  const Real l = kov_lambda(), e = std::exp(l * x[0]);
+  return {1 - e * std::cos(2 * pi * x[1]), l / (2 * pi) * e * std::sin(2 * pi * x[1])};
+}
+Mat<2> kov_grad(const Vec<2>& x) {
+  const Real l = kov_lambda(), e = std::exp(l * x[0]), c = std::cos(2 * pi * x[1]), s = std::sin(2 * pi * x[1]);
+  Mat<2> g;
+  g << -l * e * c, 2 * pi * e * s, l * l / (2 * pi) * e * s, l * e * c;
+  return g;
+}
+Real kov_p(const Vec<2>& x) { return 0.5 * (1 - std::exp(2 * kov_lambda() * x[0])); }
+
+template <class Pair>
+std::pair<Real, FlowErrors> kovasznay(int n) {
+  // one backward-Euler step with dt -> infinity is Newton's method for the steady problem
+  AleFlow<2, Pair, BSS> flow(rectangle_mesh(n, n * 4 / 3, -0.5, 1.0, -0.5, 1.5),
+                             FlowOptions{1.0, 1.0 / kov_re, Linearisation::newton, 30, 1e-12});
+  for (int t = 1; t <= 4; ++t) flow.set_velocity(t, [](const Vec<2>& x, Real) { return kov_u(x); });
+  flow.step(1e14);
+  return {Real(flow.field().size()), flow_errors<2, Pair>(flow.space(), flow.field(), kov_u, kov_grad, kov_p)};
+}
+}  // namespace
+
+TEMPLATE_TEST_CASE("steady Navier-Stokes (Kovasznay, Re = 40): spatial rates", "[ale][convergence]", TaylorHood, P1P1Gls) {
+  constexpr bool th = std::is_same_v<TestType, TaylorHood>;
+  const std::vector<int> ns = th ? std::vector<int>{12, 24, 48} : std::vector<int>{24, 48, 96};
+  std::vector<std::pair<Real, FlowErrors>> runs;
+  for (int n : ns) runs.push_back(kovasznay<TestType>(n));
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    std::cout << "Kovasznay " << TestType::name << " n=" << ns[k] << " dofs=" << runs[k].first << " u_L2=" << runs[k].second.u_l2
+              << " u_H1=" << runs[k].second.u_h1 << " p_L2=" << runs[k].second.p_l2;
+    if (k > 0)
+      std::cout << "  rates " << observed_rate(runs[k - 1].first, runs[k - 1].second.u_l2, runs[k].first, runs[k].second.u_l2, 2)
+                << " " << observed_rate(runs[k - 1].first, runs[k - 1].second.u_h1, runs[k].first, runs[k].second.u_h1, 2)
+                << " " << observed_rate(runs[k - 1].first, runs[k - 1].second.p_l2, runs[k].first, runs[k].second.p_l2, 2);
+    std::cout << "\n";
+  }
+  const auto& [N0, e0] = runs[1];
+  const auto& [N1, e1] = runs[2];
+  CHECK(observed_rate(N0, e0.u_l2, N1, e1.u_l2, 2) == Approx(th ? 3.0 : 2.0).margin(0.2));
+  CHECK(observed_rate(N0, e0.u_h1, N1, e1.u_h1, 2) == Approx(th ? 2.0 : 1.0).margin(0.15));
+  CHECK(observed_rate(N0, e0.p_l2, N1, e1.p_l2, 2) >= (th ? 1.85 : 1.4));
+}

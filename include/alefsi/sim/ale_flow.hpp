@@ -25,6 +25,7 @@
 ///     flow.set_initial_velocity(u0);
 ///     for (int n = 0; n < 100; ++n) flow.step(0.01);
 #include <array>
+#include <chrono>
 #include <functional>
 #include <map>
 #include <memory>
@@ -53,6 +54,9 @@ struct StepReport {
   int newton_iterations = 0;
   std::vector<Real> residuals;  ///< max-norm residual before each Newton update
   bool startup = false;
+  /// Wall time (s) of the step's phases: mesh-velocity solve, assembly (all Newton
+  /// iterations), numeric factorisation (incl. the one-off symbolic analysis), triangular solves.
+  Real t_mesh_velocity = 0, t_assembly = 0, t_factorize = 0, t_solve = 0;
 };
 
 template <int D, ElementPair Pair, TimeScheme Scheme, bool Convection = true, LinearSolver Solver = SparseLu<>>
@@ -179,7 +183,15 @@ class AleFlow {
       }
     // 2. mesh velocity
     const Real tV = S::velocity_level == VelocityLevel::n ? t_ : S::velocity_level == VelocityLevel::n_half ? t_ + dt / 2 : t_ + dt;
+    StepReport rep;
+    auto clock = std::chrono::steady_clock::now();
+    auto lap = [&clock](Real& acc) {
+      const auto now = std::chrono::steady_clock::now();
+      acc += std::chrono::duration<Real>(now - clock).count();
+      clock = now;
+    };
     const std::vector<Vec<D>> Vs = solve_mesh_velocity(Xh, Uh, tV);
+    lap(rep.t_mesh_velocity);
     // 3. positions
     const auto b = bdf_coefficients(S::position_bdf);
     std::vector<Vec<D>> Xn1(X_[0].size());
@@ -223,7 +235,7 @@ class AleFlow {
     if (force_) in.force = [this, tf](const Vec<D>& x) { return force_(x, tf); };
     kernel_.set_step(in);
     // 5. Newton (or one semi-implicit solve)
-    StepReport rep;
+    clock = std::chrono::steady_clock::now();
     VecX u = cons_->restrict_free(U_[0]);
     VecX field = cons_->expand(u);
     VecX r;
@@ -231,6 +243,7 @@ class AleFlow {
     const int iters = opt_.linearisation == Linearisation::newton ? opt_.max_newton : 1;
     for (int it = 0; it < iters; ++it) {
       asmb_->assemble(kernel_, field, &J_, &r);
+      lap(rep.t_assembly);
       const Real rn = r.size() ? r.lpNorm<Eigen::Infinity>() : 0.0;
       rep.residuals.push_back(rn);
       if (r0 < 0) r0 = rn;
@@ -240,7 +253,9 @@ class AleFlow {
         analysed_ = true;
       }
       solver_.factorize(J_);
+      lap(rep.t_factorize);
       u -= solver_.solve(r);
+      lap(rep.t_solve);
       field = cons_->expand(u);
       ++rep.newton_iterations;
       if (opt_.linearisation == Linearisation::newton && it + 1 == iters)

@@ -3,4 +3,5 @@
 /// The physics module: Stokes and ALE Navier-Stokes kernels, mesh motion.
 #include "alefsi/physics/mesh_motion.hpp"
 #include "alefsi/physics/navier_stokes.hpp"
+#include "alefsi/physics/rigid_body.hpp"
 #include "alefsi/physics/stokes.hpp"

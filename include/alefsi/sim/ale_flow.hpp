@@ -39,6 +39,7 @@
 #include "alefsi/mesh/mesh.hpp"
 #include "alefsi/physics/mesh_motion.hpp"
 #include "alefsi/physics/navier_stokes.hpp"
+#include "alefsi/physics/rigid_body.hpp"
 #include "alefsi/time/schemes.hpp"
 
 namespace alefsi {
@@ -96,6 +97,32 @@ class AleFlow {
     mesh_bc_[tag] = std::move(g);
   }
   void set_prescribed_mesh_velocity(TimeFunction v) { prescribed_ = std::move(v); }
+  /// Gravity: body force rho_f g on the fluid and M g on every free body.
+  void set_gravity(const Vec<D>& g) { gravity_ = g; }
+  /// Adds a rigid body (2D). Its surface facets carry `body.tag`; returns its index.
+  std::size_t add_body(const RigidBody2D& body) {
+    static_assert(D == 2, "rigid bodies are implemented in 2D so far");
+    require_not_started("add_body");
+    body.validate(bodies_.size());
+    ALEFSI_CHECK_ARG(!mesh_.boundary_nodes(body.tag).empty(), "body.tag", "no boundary facet has tag ", body.tag);
+    ALEFSI_CHECK_ARG(!dirichlet_.count(body.tag), "body.tag", "tag ", body.tag, " already has a Dirichlet velocity");
+    Body b;
+    b.data = body;
+    b.xg.fill(body.centre);
+    b.th.fill(body.angle);
+    b.Z.fill(body.prescribed ? body.prescribed(t_) : body.velocity);
+    b.nodes = mesh_.boundary_nodes(body.tag);
+    for (Index v : b.nodes) b.r0.push_back(mesh_.node(v) - body.centre);
+    bodies_.push_back(std::move(b));
+    return bodies_.size() - 1;
+  }
+  /// Body k's centre of mass, angle and velocity Z = (V1, V2, w3) at t^n.
+  Vec<D> body_centre(std::size_t k) const { return bodies_.at(k).xg[0]; }
+  Real body_angle(std::size_t k) const { return bodies_.at(k).th[0]; }
+  Vec<3> body_velocity(std::size_t k) const { return bodies_.at(k).Z[0]; }
+  /// Hydrodynamic force and torque (F1, F2, T3) on free body k over the last step, from its
+  /// momentum balance: M delta_l Z / dt - M g - external load.
+  Vec<3> body_hydrodynamic_load(std::size_t k) const { return bodies_.at(k).load; }
   void set_force(TimeFunction f) { force_ = std::move(f); }
   void set_initial_velocity(const std::function<Vec<D>(const Vec<D>&)>& u0, Real t0 = 0) {
     require_not_started("set_initial_velocity");
@@ -110,7 +137,10 @@ class AleFlow {
   StepReport step(Real dt) {
     ALEFSI_CHECK_ARG(dt > 0 && std::isfinite(dt), "dt", "time step must be positive and finite, got ", dt);
     if (!cons_) setup();
-    if (levels_ == 0) Vn_ = solve_mesh_velocity(X_[0], U_[0], t_);
+    if (levels_ == 0) {
+      set_body_mesh_velocity(X_[0], {1.0, 0.0, 0.0}, t_);
+      Vn_ = solve_mesh_velocity(X_[0], U_[0], t_);
+    }
     StepReport rep;
     if (levels_ < history_levels<Scheme>()) {
       rep = step_with<MR_AB>(dt);
@@ -137,8 +167,31 @@ class AleFlow {
         dirichlet_dofs_.push_back({i, tag});
         for (int k = 0; k < D; ++k) cons_->fix(space_.velocity_field(i, k), 0.0);
       }
-    pinned_ = true;
-    for (Index f : mesh_.boundary_facets()) pinned_ &= dirichlet_.count(mesh_.facet_tag(f)) > 0;
+    if constexpr (D == 2)
+      for (auto& b : bodies_) {
+        if (b.data.free()) b.extra = cons_->add_unknowns(3);
+        for (Index i : vel.boundary_dofs(b.data.tag)) {
+          ALEFSI_CHECK_ARG(!done[i], "body.tag", "body surface (tag ", b.data.tag, ") touches a Dirichlet wall or another body");
+          done[i] = 1;
+          b.dofs.push_back(i);
+          for (int k = 0; k < D; ++k) {
+            const Index f = space_.velocity_field(i, k);
+            if (b.data.free()) {
+              const Index ex[] = {b.extra, b.extra + 1, b.extra + 2};
+              const Real w[] = {0.0, 0.0, 0.0};
+              cons_->link(f, ex, w, 0.0);
+            } else {
+              cons_->fix(f, 0.0);
+            }
+          }
+        }
+      }
+    pinned_ = true;  // every boundary velocity prescribed (walls or bodies): p up to a constant
+    for (Index f : mesh_.boundary_facets()) {
+      bool body = false;
+      for (const auto& b : bodies_) body |= b.data.tag == mesh_.facet_tag(f);
+      pinned_ &= body || dirichlet_.count(mesh_.facet_tag(f)) > 0;
+    }
     if (pinned_) cons_->fix(space_.pressure_field(0), 0.0);
     cons_->finalize();
     asmb_ = std::make_unique<Assembler<Space::n_local>>(
@@ -158,12 +211,37 @@ class AleFlow {
       for (std::size_t i = 0; i < x.size(); ++i) v[i] = prescribed_(x[i], t);
       return v;
     }
-    // boundary data: the tag's function, 0 elsewhere
+    // boundary data: a body's rigid velocity, else the tag's function, else 0
     std::vector<const TimeFunction*> node_fn(mesh_.n_nodes(), nullptr);
     for (const auto& [tag, g] : mesh_bc_)
       for (Index v : mesh_.boundary_nodes(tag)) node_fn[v] = &g;
-    return motion_.solve(x, [&](Index v, const Vec<D>& xv) { return node_fn[v] ? (*node_fn[v])(xv, t) : Vec<D>(Vec<D>::Zero()); });
+    return motion_.solve(x, [&](Index v, const Vec<D>& xv) {
+      if (!body_v_.empty() && body_has_v_[v]) return body_v_[v];
+      return node_fn[v] ? (*node_fn[v])(xv, t) : Vec<D>(Vec<D>::Zero());
+    });
   }
+
+  // Rigid velocities of the body nodes on geometry x for the mesh-velocity problem: the bodies'
+  // extrapolated state (weights w over levels n, n-1, n-2), or the prescribed motion at t.
+  void set_body_mesh_velocity(const std::vector<Vec<D>>& x, const std::array<Real, 3>& w, Real t) {
+    if constexpr (D == 2) {
+      if (bodies_.empty()) return;
+      body_v_.assign(mesh_.n_nodes(), Vec<D>::Zero());
+      body_has_v_.assign(mesh_.n_nodes(), 0);
+      for (auto& b : bodies_) {
+        Vec<2> xg = Vec<2>::Zero();
+        Vec<3> Z = Vec<3>::Zero();
+        for (int k = 0; k < 3; ++k) xg += w[k] * b.xg[k], Z += w[k] * b.Z[k];
+        if (!b.data.free()) Z = b.data.prescribed(t);
+        b.Zhat = Z;
+        for (Index v : b.nodes) {
+          body_v_[v] = rigid_velocity(Z, x[v] - xg);
+          body_has_v_[v] = 1;
+        }
+      }
+    }
+  }
+
 
   template <TimeScheme S>
   StepReport step_with(Real dt) {
@@ -172,6 +250,11 @@ class AleFlow {
       X_[1] = X_[0];
       for (std::size_t i = 0; i < X_[1].size(); ++i) X_[1][i] -= dt * Vn_[i];
       U_[1] = U_[0];
+      for (auto& b : bodies_) {
+        b.xg[1] = b.xg[0] - dt * b.Z[0].template head<D>();
+        b.th[1] = b.th[0] - dt * b.Z[0][2];
+        b.Z[1] = b.Z[0];
+      }
     }
     // 1. extrapolated geometry and flow
     std::vector<Vec<D>> Xh(X_[0].size(), Vec<D>::Zero());
@@ -190,6 +273,7 @@ class AleFlow {
       acc += std::chrono::duration<Real>(now - clock).count();
       clock = now;
     };
+    set_body_mesh_velocity(Xh, S::extrapolation, tV);
     const std::vector<Vec<D>> Vs = solve_mesh_velocity(Xh, Uh, tV);
     lap(rep.t_mesh_velocity);
     // 3. positions
@@ -199,6 +283,17 @@ class AleFlow {
       Vec<D> s = dt * Vs[i];
       for (int k = 1; k <= S::position_bdf; ++k) s -= b[k] * X_[k - 1][i];
       Xn1[i] = s / b[0];
+    }
+    // bodies: centre and angle by the same formula with the extrapolated rigid velocity;
+    // their surface nodes are placed by the exact rigid motion
+    for (auto& body : bodies_) {
+      Vec<D> xs = dt * body.Zhat.template head<D>();
+      Real ts = dt * body.Zhat[2];
+      for (int k = 1; k <= S::position_bdf; ++k) xs -= b[k] * body.xg[k - 1], ts -= b[k] * body.th[k - 1];
+      body.xg_next = xs / b[0];
+      body.th_next = ts / b[0];
+      for (std::size_t j = 0; j < body.nodes.size(); ++j)
+        Xn1[body.nodes[j]] = body.xg_next + rotate(body.r0[j], body.th_next - body.data.angle);
     }
     // mesh velocity the flow sees, and V^{n+1} for the next step
     std::vector<Vec<D>> Vflow = Vs, Vnext = Vs;
@@ -215,6 +310,22 @@ class AleFlow {
       const Vec<D> val = dirichlet_.at(tag)(dof_point(i, Xn1), t1);
       for (int k = 0; k < D; ++k) cons_->set_fixed_value(space_.velocity_field(i, k), val[k]);
     }
+    // body surface velocities at t^{n+1} on X^{n+1}: u = H Z + u_s
+    if constexpr (D == 2)
+      for (auto& body : bodies_) {
+        const Real rot = body.th_next - body.data.angle;
+        const Vec<3> Zp = body.data.free() ? Vec<3>::Zero() : body.data.prescribed(t1);
+        for (Index i : body.dofs) {
+          const Vec<2> r = dof_point(i, Xn1) - body.xg_next;
+          const Vec<2> us = body.data.slip ? rotate(body.data.slip(rotate(r, -rot)), rot) : Vec<2>::Zero();
+          const auto H = rigid_rows(r);
+          for (int k = 0; k < 2; ++k) {
+            const Index f = space_.velocity_field(i, k);
+            if (body.data.free()) cons_->set_link(f, {H[k].data(), 3}, us[k]);
+            else cons_->set_fixed_value(f, H[k].dot(Zp) + us[k]);
+          }
+        }
+      }
     // history of the BDF time derivative and the extrapolated convecting velocity
     const auto a = bdf_coefficients(S::flow_bdf);
     VecX hist = VecX::Zero(U_[0].size());
@@ -232,17 +343,25 @@ class AleFlow {
     in.extrapolated = &ustar;
     in.mesh_velocity = &Vflow;
     const Real tf = t_ + S::theta * dt;
-    if (force_) in.force = [this, tf](const Vec<D>& x) { return force_(x, tf); };
+    if (force_ || gravity_.squaredNorm() > 0)
+      in.force = [this, tf](const Vec<D>& x) {
+        Vec<D> f = opt_.rho * gravity_;
+        if (force_) f += force_(x, tf);
+        return f;
+      };
     kernel_.set_step(in);
     // 5. Newton (or one semi-implicit solve)
     clock = std::chrono::steady_clock::now();
     VecX u = cons_->restrict_free(U_[0]);
+    for (const auto& body : bodies_)
+      if (body.data.free()) u.template segment<3>(cons_->extra_unknown(body.extra)) = body.Z[0];
     VecX field = cons_->expand(u);
     VecX r;
     Real r0 = -1;
     const int iters = opt_.linearisation == Linearisation::newton ? opt_.max_newton : 1;
     for (int it = 0; it < iters; ++it) {
       asmb_->assemble(kernel_, field, &J_, &r);
+      add_body_rows<S>(dt, u, r);
       lap(rep.t_assembly);
       const Real rn = r.size() ? r.lpNorm<Eigen::Infinity>() : 0.0;
       rep.residuals.push_back(rn);
@@ -263,6 +382,13 @@ class AleFlow {
                           std::to_string(rn) + ")");
     }
     if (pinned_) shift_pressure(field);
+    for (auto& body : bodies_) {
+      const Vec<3> Zn1 = body.data.free() ? Vec<3>(u.template segment<3>(cons_->extra_unknown(body.extra))) : body.data.prescribed(t1);
+      if (body.data.free()) body.load = body_inertia<S>(body, Zn1, dt) - body_weight(body) - body.data_external();
+      body.Z[2] = body.Z[1], body.Z[1] = body.Z[0], body.Z[0] = Zn1;
+      body.xg[2] = body.xg[1], body.xg[1] = body.xg[0], body.xg[0] = body.xg_next;
+      body.th[2] = body.th[1], body.th[1] = body.th[0], body.th[0] = body.th_next;
+    }
     // 6. shift histories
     U_[2] = U_[1];
     U_[1] = U_[0];
@@ -275,6 +401,48 @@ class AleFlow {
     t_ = t1;
     ++levels_;
     return rep;
+  }
+
+  struct Body {
+    RigidBody2D data;
+    std::array<Vec<D>, 3> xg;
+    std::array<Real, 3> th{};
+    std::array<Vec<3>, 3> Z;
+    Vec<3> Zhat = Vec<3>::Zero(), load = Vec<3>::Zero();
+    Vec<D> xg_next = Vec<D>::Zero();
+    Real th_next = 0;
+    Index extra = -1;           // first of its 3 extra unknowns (free bodies)
+    std::vector<Index> nodes;   // surface mesh nodes
+    std::vector<Vec<D>> r0;     // their offsets from the centre at t0
+    std::vector<Index> dofs;    // surface velocity DOFs
+    Vec<3> data_external() const { return data.external_load; }
+  };
+
+  // M delta_l Z^{n+1} / dt for body b.
+  template <TimeScheme S>
+  static Vec<3> body_inertia(const Body& b, const Vec<3>& Zn1, Real dt) {
+    const auto a = bdf_coefficients(S::flow_bdf);
+    Vec<3> dZ = a[0] * Zn1;
+    for (int k = 1; k <= S::flow_bdf; ++k) dZ += a[k] * b.Z[k - 1];
+    return Vec<3>(b.data.mass, b.data.mass, b.data.inertia).cwiseProduct(dZ) / dt;
+  }
+  Vec<3> body_weight(const Body& b) const {
+    Vec<3> w = Vec<3>::Zero();
+    w.template head<D>() = b.data.mass * gravity_;
+    return w;
+  }
+  // Body rows (eq. 11): M delta_l Z / dt - M g - external load, added to the fluid terms.
+  template <TimeScheme S>
+  void add_body_rows(Real dt, const VecX& u, VecX& r) {
+    const Real a0 = bdf_coefficients(S::flow_bdf)[0];
+    for (const auto& body : bodies_) {
+      if (!body.data.free()) continue;
+      const Index e = cons_->extra_unknown(body.extra);
+      const Vec<3> Z = u.template segment<3>(e);
+      r.template segment<3>(e) += body_inertia<S>(body, Z, dt) - body_weight(body) - body.data_external();
+      const Vec<3> m(body.data.mass, body.data.mass, body.data.inertia);
+      for (int C = 0; C < 3; ++C) J_.coeffRef(e + C, e + C) += m[C] * a0 / dt;
+    }
   }
 
   void shift_pressure(VecX& field) const {
@@ -297,6 +465,10 @@ class AleFlow {
   ElasticMeshMotion<D> motion_;
   std::map<int, TimeFunction> dirichlet_, mesh_bc_;
   TimeFunction prescribed_, force_;
+  Vec<D> gravity_ = Vec<D>::Zero();
+  std::vector<Body> bodies_;
+  std::vector<Vec<D>> body_v_;
+  std::vector<char> body_has_v_;
   std::vector<std::pair<Index, int>> dirichlet_dofs_;
   std::unique_ptr<DofConstraints> cons_;
   std::unique_ptr<Assembler<Space::n_local>> asmb_;

@@ -1,6 +1,7 @@
 #pragma once
 /// \file mesh.hpp
 /// The mesh module: simplex meshes, generators and file I/O.
+#include "alefsi/mesh/adapt.hpp"
 #include "alefsi/mesh/generate/mesher2d.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
 #include "alefsi/mesh/io/gmsh.hpp"

@@ -1,0 +1,172 @@
+#pragma once
+/// \file mesh/adapt/transfer.hpp
+/// Transfer of P1 / P2 finite-element fields from one 2D mesh to another (after mesh
+/// adaptation) by interpolation at the new DOF points.
+///
+/// Algorithm: every DOF point of the target space (P1: the nodes; P2: the nodes, then one
+/// point per edge, by default the straight midpoint) is located in the source mesh
+/// (`PointLocator2D`: walk from the cell found for a neighbouring point, bucket grid as
+/// fall-back); the source field is evaluated there with the P1 / P2 shape functions of
+/// the containing cell. The located cells and weights are stored once (`FieldTransfer2D`)
+/// and applied to any number of fields / history levels / components.
+///
+/// Exactness: a field in the source FE space is reproduced exactly (to round-off) at
+/// every target DOF point inside the source mesh; in particular P1 transfer is exact for
+/// affine fields and P2 transfer for quadratic fields, and the error for a smooth field
+/// is the interpolation error, O(h^2) for P1 and O(h^3) for P2 (max norm).
+///
+/// Points outside the source mesh (a new boundary node put on a circle arc lies outside
+/// the inscribed polygon of the old mesh, at a distance O(h^2 / radius)): by default
+/// (`OutsidePolicy::clamp`) the value at the point of the nearest source cell closest to
+/// it (clamped barycentric coordinates: bounded, no overshoot, error O(|grad f| * distance)
+/// = O(h^2)); with `OutsidePolicy::extrapolate` the nearest cell's polynomial evaluated
+/// at the point (exact for fields of the source space, but it may overshoot far away).
+/// `n_outside()` and `max_outside_distance()` report how many points were concerned.
+///
+/// Layout: a field with k components per DOF is stored interleaved, value of component j
+/// at DOF i at index i * k + j (as MixedSpace interleaves velocity components); the
+/// matrix overloads take one row per DOF and one column per component / field.
+///
+/// Cost: construction O(n_source + n_target) (walks of O(1) steps when the meshes are
+/// close, as after an adaptation); each application O(n_target * k).
+///
+///     alefsi::FieldTransfer2D T(old_mesh, new_mesh, 2);          // P2 plan
+///     std::vector<Real> u_new = T.apply(u_old, 2);               // 2 components per DOF
+///     auto p_new = alefsi::transfer<1>(old_mesh, p_old, 1, new_mesh);
+#include <algorithm>
+#include <array>
+#include <string>
+#include <vector>
+
+#include "alefsi/core/error.hpp"
+#include "alefsi/core/types.hpp"
+#include "alefsi/mesh/adapt/locate.hpp"
+#include "alefsi/mesh/mesh.hpp"
+
+namespace alefsi {
+
+/// What to do with target DOF points outside the source mesh.
+enum class OutsidePolicy { clamp, extrapolate };
+
+namespace detail {
+
+/// P1 / P2 shape function values at barycentric coordinates l (local order of lagrange.hpp).
+inline std::array<Real, 6> lagrange_weights(int degree, const Vec<3>& l) {
+  if (degree == 1) return {l[0], l[1], l[2], 0, 0, 0};
+  return {l[0] * (2 * l[0] - 1), l[1] * (2 * l[1] - 1), l[2] * (2 * l[2] - 1),
+          4 * l[0] * l[1],       4 * l[1] * l[2],       4 * l[2] * l[0]};
+}
+
+/// Number of DOFs of the scalar P1 / P2 space on a mesh (numbering of DofMap).
+inline Index lagrange_dofs(const Mesh<2>& m, int degree) { return m.n_nodes() + (degree == 2 ? m.n_edges() : 0); }
+
+}  // namespace detail
+
+/// Precomputed interpolation from the P`degree` space of `from` to that of `to`.
+class FieldTransfer2D {
+ public:
+  /// `to_edge_points` (P2 only, optional): the DOF point of each edge of `to` (indexed as
+  /// to.edges()), e.g. the arc midpoint for edges on a circle; default: straight midpoints.
+  FieldTransfer2D(const Mesh<2>& from, const Mesh<2>& to, int degree, const std::vector<Vec<2>>& to_edge_points = {},
+                  OutsidePolicy outside = OutsidePolicy::clamp)
+      : degree_(degree) {
+    ALEFSI_CHECK_ARG(degree == 1 || degree == 2, "degree", "must be 1 or 2, got ", degree);
+    ALEFSI_CHECK_ARG(to_edge_points.empty() || (degree == 2 && to_edge_points.size() == std::size_t(to.n_edges())),
+                     "to_edge_points", "must be empty or (P2) have one point per edge of 'to' (", to.n_edges(), "), got ",
+                     to_edge_points.size());
+    n_from_ = detail::lagrange_dofs(from, degree);
+    n_to_ = detail::lagrange_dofs(to, degree);
+    nl_ = degree == 1 ? 3 : 6;
+    idx_.resize(std::size_t(n_to_) * nl_);
+    w_.resize(std::size_t(n_to_) * nl_);
+    const PointLocator2D loc(from);
+
+    // a neighbour with a smaller index for each target node: its cell is the walk's start
+    std::vector<Index> nb(std::size_t(to.n_nodes()), -1);
+    for (const auto& e : to.edges())
+      if (nb[e[1]] < 0 || e[0] < nb[e[1]]) nb[e[1]] = e[0];
+    std::vector<Index> found(std::size_t(to.n_nodes()), -1);
+    Index prev = -1;
+    auto store = [&](Index dof, const Vec<2>& x, Index hint) {
+      const Location l = loc.find(x, hint);
+      if (l.distance > 0) ++n_outside_, max_outside_ = std::max(max_outside_, l.distance);
+      const auto w = detail::lagrange_weights(degree, outside == OutsidePolicy::extrapolate ? l.raw : l.lambda);
+      const auto& cv = from.cell(l.cell);
+      for (int i = 0; i < 3; ++i) idx_[std::size_t(dof) * nl_ + i] = cv[i];
+      if (degree == 2)
+        for (int e = 0; e < 3; ++e) idx_[std::size_t(dof) * nl_ + 3 + e] = from.n_nodes() + from.cell_edges(l.cell)[e];
+      for (int i = 0; i < nl_; ++i) w_[std::size_t(dof) * nl_ + i] = w[i];
+      return l.cell;
+    };
+    for (Index v = 0; v < to.n_nodes(); ++v) {
+      const Index hint = nb[v] >= 0 && nb[v] < v ? found[nb[v]] : prev;
+      prev = found[v] = store(v, to.node(v), hint);
+    }
+    if (degree == 2)
+      for (Index e = 0; e < to.n_edges(); ++e) {
+        const auto& ev = to.edge(e);
+        const Vec<2> x = to_edge_points.empty() ? Vec<2>(0.5 * (to.node(ev[0]) + to.node(ev[1]))) : to_edge_points[e];
+        store(to.n_nodes() + e, x, found[ev[0]]);
+      }
+  }
+
+  int degree() const { return degree_; }
+  Index n_source_dofs() const { return n_from_; }
+  Index n_target_dofs() const { return n_to_; }
+  /// Number of target DOF points outside the source mesh, and their largest distance to it.
+  Index n_outside() const { return n_outside_; }
+  Real max_outside_distance() const { return max_outside_; }
+
+  /// One field with `components` interleaved components per DOF.
+  std::vector<Real> apply(const std::vector<Real>& values, int components = 1) const {
+    ALEFSI_CHECK_ARG(components >= 1, "components", "must be >= 1, got ", components);
+    ALEFSI_CHECK_ARG(values.size() == std::size_t(n_from_) * std::size_t(components), "values", "has ", values.size(),
+                     " entries, expected ", n_from_, " DOFs x ", components, " components");
+    const std::size_t k = std::size_t(components);
+    std::vector<Real> out(std::size_t(n_to_) * k, 0.0);
+    for (std::size_t i = 0; i < std::size_t(n_to_); ++i)
+      for (int j = 0; j < nl_; ++j) {
+        const Real w = w_[i * nl_ + j];
+        const std::size_t src = std::size_t(idx_[i * nl_ + j]) * k;
+        for (std::size_t c = 0; c < k; ++c) out[i * k + c] += w * values[src + c];
+      }
+    return out;
+  }
+
+  /// Several fields (e.g. the history levels of a multistep scheme), same layout each.
+  std::vector<std::vector<Real>> apply(const std::vector<std::vector<Real>>& fields, int components = 1) const {
+    std::vector<std::vector<Real>> out;
+    out.reserve(fields.size());
+    for (const auto& f : fields) out.push_back(apply(f, components));
+    return out;
+  }
+
+  /// One row per source DOF, any number of columns (components / fields).
+  MatX apply(const MatX& values) const {
+    ALEFSI_CHECK_ARG(values.rows() == n_from_, "values", "has ", values.rows(), " rows, expected ", n_from_, " DOFs");
+    MatX out = MatX::Zero(n_to_, values.cols());
+    for (Index i = 0; i < n_to_; ++i)
+      for (int j = 0; j < nl_; ++j)
+        out.row(i) += w_[std::size_t(i) * nl_ + j] * values.row(idx_[std::size_t(i) * nl_ + j]);
+    return out;
+  }
+
+ private:
+  int degree_;
+  int nl_ = 3;
+  Index n_from_ = 0, n_to_ = 0, n_outside_ = 0;
+  Real max_outside_ = 0;
+  std::vector<Index> idx_;
+  std::vector<Real> w_;
+};
+
+/// One-shot transfer of a P`K` field (K = 1 or 2) with `components` interleaved
+/// components per DOF; see FieldTransfer2D.
+template <int K>
+std::vector<Real> transfer(const Mesh<2>& from, const std::vector<Real>& values, int components, const Mesh<2>& to,
+                           const std::vector<Vec<2>>& to_edge_points = {}, OutsidePolicy outside = OutsidePolicy::clamp) {
+  static_assert(K == 1 || K == 2, "transfer<K>: K is the Lagrange degree, 1 or 2");
+  return FieldTransfer2D(from, to, K, to_edge_points, outside).apply(values, components);
+}
+
+}  // namespace alefsi

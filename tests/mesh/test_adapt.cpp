@@ -1,0 +1,464 @@
+// Tests of 2D mesh adaptation and field transfer (mesh/adapt.hpp).
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "alefsi/mesh/adapt.hpp"
+
+using namespace alefsi;
+
+namespace {
+
+constexpr double pi = std::numbers::pi;
+
+double worst_quality(const Mesh<2>& m) {
+  double q = 1;
+  for (Index c = 0; c < m.n_cells(); ++c) q = std::min(q, m.quality(c));
+  return q;
+}
+
+/// Ratios edge length / h(edge midpoint): {min, max}.
+std::pair<double, double> size_band(const Mesh<2>& m, const SizeFunction& h) {
+  double lo = 1e300, hi = 0;
+  for (Index e = 0; e < m.n_edges(); ++e) {
+    const Vec<2> mid = 0.5 * (m.node(m.edge(e)[0]) + m.node(m.edge(e)[1]));
+    const double r = m.edge_length(e) / h(mid);
+    lo = std::min(lo, r), hi = std::max(hi, r);
+  }
+  return {lo, hi};
+}
+
+/// Area of the polygon through the boundary nodes with the given tag, ordered by angle
+/// around `centre` (for a circle: the inscribed polygon the mesh actually uses).
+double tagged_polygon_area(const Mesh<2>& m, int tag, const Vec<2>& centre) {
+  std::vector<Vec<2>> p;
+  for (Index v : m.boundary_nodes(tag)) p.push_back(m.node(v) - centre);
+  std::sort(p.begin(), p.end(), [](const Vec<2>& a, const Vec<2>& b) { return std::atan2(a[1], a[0]) < std::atan2(b[1], b[0]); });
+  double a = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) a += p[i][0] * p[(i + 1) % p.size()][1] - p[(i + 1) % p.size()][0] * p[i][1];
+  return 0.5 * a;
+}
+
+double max_circle_error(const Mesh<2>& m, int tag, const Circle& c) {
+  double e = 0;
+  for (Index v : m.boundary_nodes(tag)) e = std::max(e, std::abs((m.node(v) - c.centre).norm() - c.radius));
+  return e;
+}
+
+/// Every boundary facet carries one of the expected tags; every boundary node is on 2 facets.
+void check_boundary_tags(const Mesh<2>& m, const std::vector<int>& expected) {
+  std::vector<int> count(static_cast<std::size_t>(m.n_nodes()), 0);
+  for (Index f : m.boundary_facets()) {
+    CHECK(std::find(expected.begin(), expected.end(), m.facet_tag(f)) != expected.end());
+    for (Index v : m.facet(f)) ++count[v];
+  }
+  for (int c : count) CHECK((c == 0 || c == 2));
+}
+
+Polyline channel_walls(double W, double H) {
+  return Polyline{{Vec<2>(0, 0), Vec<2>(W, 0), Vec<2>(W, H), Vec<2>(0, H)}, 0, {tags::bottom, tags::right, tags::top, tags::left}};
+}
+
+/// Values of f at the P1 (degree 1) or P2 (degree 2) DOF points of a mesh (DofMap numbering).
+std::vector<double> interpolate(const Mesh<2>& m, int degree, const std::function<double(const Vec<2>&)>& f) {
+  std::vector<double> v;
+  for (Index i = 0; i < m.n_nodes(); ++i) v.push_back(f(m.node(i)));
+  if (degree == 2)
+    for (Index e = 0; e < m.n_edges(); ++e) v.push_back(f(0.5 * (m.node(m.edge(e)[0]) + m.node(m.edge(e)[1]))));
+  return v;
+}
+
+Mesh<2> square_mesh(double h) {
+  Domain2D dom{Polyline{{Vec<2>(0, 0), Vec<2>(1, 0), Vec<2>(1, 1), Vec<2>(0, 1)}, 1}};
+  return generate_mesh(dom, MesherOptions{uniform_size(h)});
+}
+
+/// rectangle_mesh moved by a smooth map of the unit square onto itself (boundary fixed).
+Mesh<2> perturbed_square(int n) {
+  Mesh<2> m = rectangle_mesh(n, n);
+  std::vector<Vec<2>> x = m.coordinates();
+  for (auto& p : x) p += 0.06 * std::sin(pi * p[0]) * std::sin(pi * p[1]) * Vec<2>(1.0, -0.7);
+  m.set_coordinates(x);
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("adapt: annulus with the inner disk rotated by 2 pi, adapted every step", "[mesh][adapt]") {
+  const double r1 = 0.25, r2 = 1.0, h = 0.05;
+  const int steps = 80;
+  Mesh<2> m = annulus_unstructured(r1, r2, h);
+  const Circle inner{Vec<2>::Zero(), r1, tags::inner}, outer{Vec<2>::Zero(), r2, tags::outer};
+  const std::vector<BoundaryCurve> curves{outer, inner};
+  AdaptOptions opt;
+  opt.size = uniform_size(h);
+  const double dtheta = 2 * pi / steps;
+  auto affine = [](const Vec<2>& x) { return 1.0 + 2.0 * x[0] - 3.0 * x[1]; };
+  double worst_angle = 180, worst_q = 1, band_lo = 1e9, band_hi = 0;
+  int ops = 0;
+  std::printf("annulus rotation: %d cells at start\n", m.n_cells());
+  for (int s = 0; s < steps; ++s) {
+    // smooth ALE motion: rotation by dtheta * w(r), w = 1 on the disk, 0 on the outer wall
+    std::vector<Vec<2>> x = m.coordinates();
+    for (auto& p : x) {
+      const double u = std::clamp((p.norm() - r1) / (r2 - r1), 0.0, 1.0);
+      const double a = dtheta * 0.5 * (1 + std::cos(pi * u));
+      p = Vec<2>(std::cos(a) * p[0] - std::sin(a) * p[1], std::sin(a) * p[0] + std::cos(a) * p[1]);
+    }
+    Mesh<2> moved = m;
+    moved.set_coordinates(x);  // throws if the motion inverted a cell
+    AdaptReport rep;
+    m = adapt(moved, curves, opt, &rep);  // the Mesh constructor throws on an inverted cell
+    const auto [lo, hi] = size_band(m, opt.size);
+    std::printf("  step %2d: moved min angle %5.2f q %.3f -> adapted %5d cells, min angle %5.2f, worst q %.3f, "
+                "L/h in [%.2f, %.2f] (split %d collapse %d flip %d smooth %d refused %d)\n",
+                s, min_angle_deg(moved), worst_quality(moved), m.n_cells(), rep.min_angle_deg, rep.worst_quality, lo, hi,
+                rep.splits, rep.collapses, rep.flips, rep.smoothed, rep.refused);
+    worst_angle = std::min(worst_angle, rep.min_angle_deg);
+    worst_q = std::min(worst_q, rep.worst_quality);
+    band_lo = std::min(band_lo, lo), band_hi = std::max(band_hi, hi);
+    ops += rep.splits + rep.collapses + rep.flips;
+    REQUIRE(rep.worst_quality == Approx(worst_quality(m)));
+    // boundary: nodes on their circles, tags carried, area = polygon area (no overlap, no gap)
+    CHECK(max_circle_error(m, tags::inner, inner) <= 1e-14);
+    CHECK(max_circle_error(m, tags::outer, outer) <= 1e-14);
+    check_boundary_tags(m, {tags::inner, tags::outer});
+    const double poly = tagged_polygon_area(m, tags::outer, Vec<2>::Zero()) - tagged_polygon_area(m, tags::inner, Vec<2>::Zero());
+    CHECK(m.total_measure() == Approx(poly).epsilon(1e-12));
+    CHECK(m.total_measure() == Approx(pi * (r2 * r2 - r1 * r1)).epsilon(h * h));
+    // transfer from the moved to the adapted mesh: exact for an affine field (points on
+    // the arcs lie outside the old polygon: extrapolation keeps it exact)
+    const auto v = transfer<1>(moved, interpolate(moved, 1, affine), 1, m, {}, OutsidePolicy::extrapolate);
+    double err = 0;
+    for (Index i = 0; i < m.n_nodes(); ++i) err = std::max(err, std::abs(v[i] - affine(m.node(i))));
+    CHECK(err <= 1e-12);
+  }
+  std::printf("annulus rotation: worst min angle %.2f deg, worst quality %.3f, L/h in [%.2f, %.2f], %d cells at the end\n",
+              worst_angle, worst_q, band_lo, band_hi, m.n_cells());
+  // floors chosen from the measurement (see the report) with a margin
+  CHECK(worst_angle >= 20.0);
+  CHECK(worst_q >= 0.55);
+  CHECK(band_lo >= 0.25);
+  CHECK(band_hi <= 1.0 + opt.tolerance);
+  CHECK(ops > 1000);  // the mesh was really reconnected
+}
+
+TEST_CASE("adapt: disk translated across a channel, adapted every step", "[mesh][adapt]") {
+  const double W = 6, H = 2, r = 0.125, hb = 0.02, travel = 1.5;  // 6 diameters
+  const int steps = 60;
+  Vec<2> c(1, 1);
+  Mesh<2> m = channel_with_disks(W, H, {Circle{c, r, 5}}, hb, 10 * hb);
+  const Polyline walls = channel_walls(W, H);
+  double worst_angle = 180, worst_q = 1, band_lo = 1e9, band_hi = 0;
+  int splits = 0, collapses = 0, refused = 0;
+  std::printf("channel with a moving disk: %d cells at start\n", m.n_cells());
+  for (int s = 0; s < steps; ++s) {
+    // smooth bump displacement: rigid on and near the disk, zero beyond 0.5 from it
+    const double dx = travel / steps;
+    std::vector<Vec<2>> x = m.coordinates();
+    for (auto& p : x) {
+      const double u = std::clamp(((p - c).norm() - (r + 0.05)) / 0.45, 0.0, 1.0);
+      p[0] += dx * 0.5 * (1 + std::cos(pi * u));
+    }
+    c[0] += dx;
+    Mesh<2> moved = m;
+    moved.set_coordinates(x);
+    const Circle disk{c, r, 5};
+    AdaptOptions opt;
+    opt.size = graded_size({disk}, hb, 10 * hb);
+    AdaptReport rep;
+    m = adapt(moved, {walls, disk}, opt, &rep);
+    const auto [lo, hi] = size_band(m, opt.size);
+    std::printf("  step %2d: moved min angle %5.2f q %.3f -> adapted %5d cells, min angle %5.2f, worst q %.3f, "
+                "L/h in [%.2f, %.2f] (split %d collapse %d flip %d smooth %d refused %d)\n",
+                s, min_angle_deg(moved), worst_quality(moved), m.n_cells(), rep.min_angle_deg, rep.worst_quality, lo, hi,
+                rep.splits, rep.collapses, rep.flips, rep.smoothed, rep.refused);
+    worst_angle = std::min(worst_angle, rep.min_angle_deg);
+    worst_q = std::min(worst_q, rep.worst_quality);
+    band_lo = std::min(band_lo, lo), band_hi = std::max(band_hi, hi);
+    splits += rep.splits, collapses += rep.collapses, refused += rep.refused;
+    // walls stay straight, corners stay, disk nodes on the moved circle
+    for (Index v : m.boundary_nodes(tags::bottom)) CHECK(m.node(v)[1] == 0.0);
+    for (Index v : m.boundary_nodes(tags::top)) CHECK(m.node(v)[1] == H);
+    for (Index v : m.boundary_nodes(tags::left)) CHECK(m.node(v)[0] == 0.0);
+    for (Index v : m.boundary_nodes(tags::right)) CHECK(m.node(v)[0] == W);
+    int corners = 0;
+    for (Index v = 0; v < m.n_nodes(); ++v)
+      for (const auto& p : walls.points) corners += m.node(v) == p;
+    CHECK(corners == 4);
+    CHECK(max_circle_error(m, 5, disk) <= 1e-14);
+    check_boundary_tags(m, {tags::bottom, tags::right, tags::top, tags::left, 5});
+    // straight walls: the area is W * H minus the disk's polygon, to round-off
+    CHECK(m.total_measure() == Approx(W * H - tagged_polygon_area(m, 5, c)).epsilon(1e-13));
+  }
+  std::printf("channel: worst min angle %.2f deg, worst quality %.3f, L/h in [%.2f, %.2f], %d splits, %d collapses\n",
+              worst_angle, worst_q, band_lo, band_hi, splits, collapses);
+  CHECK(worst_angle >= 20.0);
+  CHECK(worst_q >= 0.55);
+  CHECK(band_lo >= 0.2);  // collapses refused for quality leave a few edges below 0.3 h
+  CHECK(band_hi <= 1.7);
+  CHECK(splits > 0);
+  CHECK(collapses > 0);
+  CHECK(refused > 0);  // some operations were refused, and every mesh was still valid
+}
+
+TEST_CASE("adapt: paper mode (no size function) restores sizes of a compressed mesh", "[mesh][adapt]") {
+  // a smooth monotone map x -> x^2.5: edges near x = 0 shrink, near x = 1 grow
+  Mesh<2> moved = rectangle_mesh(16, 16);
+  std::vector<Vec<2>> x = moved.coordinates();
+  for (auto& p : x) p[0] = std::pow(p[0], 2.5);
+  moved.set_coordinates(x);
+  const std::vector<BoundaryCurve> curves{channel_walls(1, 1)};
+  AdaptOptions opt;  // no size: E from the *input* mesh's node sizes
+  AdaptReport rep;
+  const Mesh<2> out = adapt(moved, curves, opt, &rep);
+  std::printf("paper mode: %d -> %d cells, %d splits, %d collapses, min angle %.2f -> %.2f\n", moved.n_cells(),
+              out.n_cells(), rep.splits, rep.collapses, min_angle_deg(moved), rep.min_angle_deg);
+  CHECK(out.total_measure() == Approx(1.0).epsilon(1e-13));
+  CHECK(rep.changed);
+  CHECK(rep.flips + rep.smoothed > 0);
+  CHECK(rep.min_angle_deg > min_angle_deg(moved));
+  // with a size function the compressed strip is coarsened and the stretched part refined
+  opt.size = uniform_size(1.0 / 16);
+  const Mesh<2> out2 = adapt(moved, curves, opt, &rep);
+  CHECK(rep.splits > 0);
+  CHECK(rep.collapses > 0);
+  const auto [lo, hi] = size_band(out2, opt.size);
+  std::printf("uniform target: %d cells, L/h in [%.2f, %.2f], min angle %.2f\n", out2.n_cells(), lo, hi, rep.min_angle_deg);
+  CHECK(hi <= 1.7);
+  CHECK(rep.min_angle_deg >= 20.0);
+  CHECK(out2.total_measure() == Approx(1.0).epsilon(1e-13));
+  CHECK(out2.boundary_nodes(tags::bottom).size() >= 2);
+}
+
+TEST_CASE("adapt: deterministic, and an unchanged good mesh stays valid", "[mesh][adapt]") {
+  Mesh<2> m = annulus_unstructured(0.25, 1.0, 0.1);
+  const std::vector<BoundaryCurve> curves{Circle{Vec<2>::Zero(), 1.0, tags::outer}, Circle{Vec<2>::Zero(), 0.25, tags::inner}};
+  std::vector<Vec<2>> x = m.coordinates();
+  for (auto& p : x) p *= 1.0 + 0.3 * (1 - p.norm()) * (p.norm() - 0.25);  // boundary nodes stay
+  m.set_coordinates(x);
+  AdaptOptions opt;
+  opt.size = uniform_size(0.08);
+  const Mesh<2> a = adapt(m, curves, opt), b = adapt(m, curves, opt);
+  REQUIRE(a.n_nodes() == b.n_nodes());
+  REQUIRE(a.cells() == b.cells());
+  CHECK(a.coordinates() == b.coordinates());
+  CHECK(a.cell_tags() == b.cell_tags());
+}
+
+TEST_CASE("adapt: unknown boundary tags are kept fixed, region tags preserved", "[mesh][adapt]") {
+  Mesh<2> m = rectangle_mesh(12, 12);
+  std::vector<int> ctags(static_cast<std::size_t>(m.n_cells()));
+  for (Index c = 0; c < m.n_cells(); ++c) ctags[c] = m.centroid(c)[0] < 0.5 ? 1 : 2;
+  std::vector<Mesh<2>::Facet> f;
+  std::vector<int> t;
+  for (Index b : m.boundary_facets()) f.push_back(m.facet(b)), t.push_back(m.facet_tag(b));
+  Mesh<2> tagged(m.coordinates(), m.cells(), f, t, ctags);
+  std::vector<Vec<2>> x = tagged.coordinates();
+  for (auto& p : x) p[1] = p[1] * p[1];  // compress near y = 0
+  tagged.set_coordinates(x);
+  AdaptOptions opt;
+  opt.size = uniform_size(1.0 / 12);
+  AdaptReport rep;
+  const Mesh<2> out = adapt(tagged, {}, opt, &rep);  // no curves: every boundary node fixed
+  CHECK(out.total_measure() == Approx(1.0).epsilon(1e-13));
+  // boundary nodes: no boundary node removed, the only new ones are chord midpoints
+  for (int tag : {1, 2, 3, 4}) CHECK(out.boundary_nodes(tag).size() >= tagged.boundary_nodes(tag).size());
+  // region interface x = 0.5 intact: cells of tag 1 left of it, of tag 2 right of it
+  double area1 = 0;
+  for (Index c = 0; c < out.n_cells(); ++c) {
+    if (out.cell_tag(c) == 1) {
+      area1 += out.measure(c);
+      CHECK(out.centroid(c)[0] < 0.5);
+    } else {
+      CHECK(out.centroid(c)[0] > 0.5);
+    }
+  }
+  CHECK(area1 == Approx(0.5).epsilon(1e-13));
+}
+
+TEST_CASE("locate: bucket grid, walk with hint, nearest cell outside", "[mesh][adapt]") {
+  const Mesh<2> m = annulus_unstructured(0.25, 1.0, 0.1);
+  const PointLocator2D loc(m);
+  for (int k = 0; k < 200; ++k) {
+    const double r = 0.26 + 0.73 * (k % 17) / 16.0, a = 0.37 * k;
+    const Vec<2> x(r * std::cos(a), r * std::sin(a));
+    Vec<3> l;
+    const Index c = loc.locate(x, &l);
+    REQUIRE(c >= 0);
+    const auto& v = m.cell(c);
+    CHECK((l[0] * m.node(v[0]) + l[1] * m.node(v[1]) + l[2] * m.node(v[2]) - x).norm() <= 1e-13);
+    CHECK(l.minCoeff() >= 0.0);
+    Vec<3> l2;
+    const Index c2 = loc.locate(x, &l2, (7 * k) % m.n_cells());  // walk from an arbitrary cell
+    const auto& v2 = m.cell(c2);
+    CHECK((l2[0] * m.node(v2[0]) + l2[1] * m.node(v2[1]) + l2[2] * m.node(v2[2]) - x).norm() <= 1e-13);
+  }
+  // outside: in the hole and beyond the outer circle: nearest cell, clamped coordinates
+  for (const Vec<2>& x : {Vec<2>(0.0, 0.0), Vec<2>(0.1, 0.05), Vec<2>(1.3, -0.2), Vec<2>(-5.0, 4.0)}) {
+    const Location L = loc.find(x);
+    REQUIRE(L.cell >= 0);
+    CHECK(L.distance > 0);
+    CHECK(L.lambda.minCoeff() >= 0.0);
+    CHECK(L.lambda.sum() == Approx(1.0));
+    const auto& v = m.cell(L.cell);
+    const Vec<2> p = L.lambda[0] * m.node(v[0]) + L.lambda[1] * m.node(v[1]) + L.lambda[2] * m.node(v[2]);
+    CHECK((p - x).norm() == Approx(L.distance));
+    // brute force: no cell is closer
+    double best = 1e300;
+    for (Index c = 0; c < m.n_cells(); ++c) {
+      const auto& w = m.cell(c);
+      const Vec<3> q = detail::closest_barycentric(m.node(w[0]), m.node(w[1]), m.node(w[2]), x);
+      best = std::min(best, (q[0] * m.node(w[0]) + q[1] * m.node(w[1]) + q[2] * m.node(w[2]) - x).norm());
+    }
+    CHECK(L.distance == Approx(best).epsilon(1e-12));
+  }
+}
+
+TEST_CASE("transfer: exact for affine (P1) and quadratic (P2) fields", "[mesh][adapt]") {
+  const Mesh<2> from = perturbed_square(9);
+  const Mesh<2> to = square_mesh(0.07);
+  auto lin = [](const Vec<2>& x) { return 0.5 - 1.5 * x[0] + 2.5 * x[1]; };
+  auto quad = [](const Vec<2>& x) { return 1 + x[0] - 2 * x[1] + 3 * x[0] * x[0] - x[0] * x[1] + 2 * x[1] * x[1]; };
+  const FieldTransfer2D T1(from, to, 1);
+  CHECK(T1.n_outside() == 0);
+  const auto v1 = T1.apply(interpolate(from, 1, lin));
+  const auto e1 = interpolate(to, 1, lin);
+  for (std::size_t i = 0; i < v1.size(); ++i) CHECK(std::abs(v1[i] - e1[i]) <= 1e-12);
+  const FieldTransfer2D T2(from, to, 2);
+  const auto v2 = T2.apply(interpolate(from, 2, quad));
+  const auto e2 = interpolate(to, 2, quad);
+  REQUIRE(v2.size() == std::size_t(to.n_nodes() + to.n_edges()));
+  for (std::size_t i = 0; i < v2.size(); ++i) CHECK(std::abs(v2[i] - e2[i]) <= 1e-12);
+
+  // several components, several history levels, matrix form: all the same numbers
+  const std::vector<double> s0 = interpolate(from, 2, quad), s1 = interpolate(from, 2, lin);
+  std::vector<double> inter(2 * s0.size());
+  MatX mat(static_cast<Index>(s0.size()), 2);
+  for (std::size_t i = 0; i < s0.size(); ++i) {
+    inter[2 * i] = s0[i], inter[2 * i + 1] = s1[i];
+    mat(Index(i), 0) = s0[i], mat(Index(i), 1) = s1[i];
+  }
+  const auto levels = T2.apply(std::vector<std::vector<double>>{s0, s1});
+  const auto both = T2.apply(inter, 2);
+  const MatX mout = T2.apply(mat);
+  const auto e2l = interpolate(to, 2, lin);
+  for (std::size_t i = 0; i < e2.size(); ++i) {
+    CHECK(both[2 * i] == levels[0][i]);
+    CHECK(both[2 * i + 1] == levels[1][i]);
+    CHECK(mout(Index(i), 0) == Approx(levels[0][i]).margin(1e-14));
+    CHECK(std::abs(levels[1][i] - e2l[i]) <= 1e-12);
+  }
+}
+
+TEST_CASE("transfer: outside points (curved boundary) clamped or extrapolated", "[mesh][adapt]") {
+  // the finer annulus has boundary nodes on the arcs between the coarse one's nodes:
+  // outside the coarse inscribed polygons, at distance <= h^2 / (8 r) + ...
+  const Mesh<2> from = annulus_unstructured(0.25, 1.0, 0.12);
+  const Mesh<2> to = annulus_unstructured(0.25, 1.0, 0.05);
+  auto lin = [](const Vec<2>& x) { return 2.0 + 3.0 * x[0] - 1.0 * x[1]; };
+  const double grad = std::sqrt(10.0);
+  const FieldTransfer2D clamp(from, to, 1);
+  const FieldTransfer2D extra(from, to, 1, {}, OutsidePolicy::extrapolate);
+  std::printf("outside points: %d of %d, max distance %.2e\n", clamp.n_outside(), to.n_nodes(), clamp.max_outside_distance());
+  CHECK(clamp.n_outside() > 0);
+  CHECK(clamp.n_outside() == extra.n_outside());
+  CHECK(clamp.max_outside_distance() <= 0.12 * 0.12 / (8 * 0.25) * 1.5);
+  const auto src = interpolate(from, 1, lin);
+  const double lo = *std::min_element(src.begin(), src.end()), hi = *std::max_element(src.begin(), src.end());
+  const auto vc = clamp.apply(src), ve = extra.apply(src);
+  double err_c = 0;
+  for (Index i = 0; i < to.n_nodes(); ++i) {
+    const double exact = lin(to.node(i));
+    err_c = std::max(err_c, std::abs(vc[i] - exact));
+    CHECK(std::abs(ve[i] - exact) <= 1e-12);          // extrapolation: exact for the space
+    CHECK((vc[i] >= lo - 1e-12 && vc[i] <= hi + 1e-12));  // clamping: no overshoot
+  }
+  CHECK(err_c > 1e-8);  // the clamped value is the one at the nearest point of the old mesh
+  CHECK(err_c <= grad * clamp.max_outside_distance() + 1e-12);
+
+  // P2 with the edge DOFs of the boundary edges on the arcs: quadratic field reproduced
+  // by extrapolation; clamped: error O(h^2) at those points only
+  auto quad = [](const Vec<2>& x) { return 1 + x[0] * x[0] - 2 * x[0] * x[1] + 0.5 * x[1]; };
+  const Domain2D dom{Circle{Vec<2>::Zero(), 1.0, tags::outer}, {Circle{Vec<2>::Zero(), 0.25, tags::inner}}};
+  const std::vector<Vec<2>> arcs = curved_edge_midpoints(to, dom);
+  const auto src2 = interpolate(from, 2, quad);
+  const auto v2 = FieldTransfer2D(from, to, 2, arcs, OutsidePolicy::extrapolate).apply(src2);
+  const auto c2 = FieldTransfer2D(from, to, 2, arcs).apply(src2);
+  double err2 = 0;
+  for (Index i = 0; i < to.n_nodes() + to.n_edges(); ++i) {
+    const Vec<2> p = i < to.n_nodes() ? to.node(i) : arcs[i - to.n_nodes()];
+    CHECK(std::abs(v2[i] - quad(p)) <= 1e-12);
+    err2 = std::max(err2, std::abs(c2[i] - quad(p)));
+  }
+  CHECK(err2 <= 4 * clamp.max_outside_distance());
+}
+
+TEST_CASE("transfer: convergence at the interpolation order for a smooth field", "[mesh][adapt]") {
+  auto f = [](const Vec<2>& x) { return std::sin(3 * x[0] + 1) * std::cos(2 * x[1]); };
+  const Mesh<2> to = square_mesh(0.02);
+  for (int degree : {1, 2}) {
+    std::vector<double> emax, erms;
+    for (int n : {8, 16, 32, 64}) {
+      const Mesh<2> from = perturbed_square(n);
+      const auto v = FieldTransfer2D(from, to, degree).apply(interpolate(from, degree, f));
+      const auto e = interpolate(to, degree, f);
+      double mx = 0, s2 = 0;
+      for (std::size_t i = 0; i < v.size(); ++i) mx = std::max(mx, std::abs(v[i] - e[i])), s2 += (v[i] - e[i]) * (v[i] - e[i]);
+      emax.push_back(mx), erms.push_back(std::sqrt(s2 / double(v.size())));
+    }
+    for (std::size_t k = 1; k < emax.size(); ++k) {
+      const double rmax = std::log2(emax[k - 1] / emax[k]), rrms = std::log2(erms[k - 1] / erms[k]);
+      std::printf("P%d transfer, h = 1/%d: max error %.3e (rate %.2f), rms %.3e (rate %.2f)\n", degree, 8 << k, emax[k],
+                  rmax, erms[k], rrms);
+      CHECK(rmax >= degree + 1 - 0.25);
+      CHECK(rrms >= degree + 1 - 0.2);
+    }
+  }
+}
+
+TEST_CASE("adapt and transfer: bad input names the parameter", "[mesh][adapt]") {
+  const Mesh<2> m = rectangle_mesh(4, 4);
+  auto param_of = [](auto&& fn) {
+    try {
+      fn();
+    } catch (const InvalidArgument& e) {
+      return e.parameter();
+    }
+    return std::string("<no throw>");
+  };
+  AdaptOptions opt;
+  opt.tolerance = 0;
+  CHECK(param_of([&] { adapt(m, {}, opt); }) == "tolerance");
+  opt = {}, opt.tolerance = std::nan("");
+  CHECK(param_of([&] { adapt(m, {}, opt); }) == "tolerance");
+  opt = {}, opt.min_quality = 1.0;
+  CHECK(param_of([&] { adapt(m, {}, opt); }) == "min_quality");
+  opt = {}, opt.smoothing_sweeps = -1;
+  CHECK(param_of([&] { adapt(m, {}, opt); }) == "smoothing_sweeps");
+  opt = {}, opt.max_passes = 0;
+  CHECK(param_of([&] { adapt(m, {}, opt); }) == "max_passes");
+  opt = {}, opt.size = [](const Vec<2>&) { return 0.0; };
+  CHECK(param_of([&] { adapt(m, {}, opt); }) == "size");
+  opt = {};
+  CHECK(param_of([&] { adapt(m, {Circle{Vec<2>::Zero(), -1.0, 1}}, opt); }) == "curves[0].radius");
+  CHECK(param_of([&] { adapt(m, {Polyline{{Vec<2>(0, 0), Vec<2>(1, 0)}, 1}}, opt); }) == "curves[0].points");
+
+  CHECK(param_of([&] { FieldTransfer2D(m, m, 3); }) == "degree");
+  CHECK(param_of([&] { FieldTransfer2D(m, m, 1, std::vector<Vec<2>>(3)); }) == "to_edge_points");
+  CHECK(param_of([&] { FieldTransfer2D(m, m, 2, std::vector<Vec<2>>(3)); }) == "to_edge_points");
+  const FieldTransfer2D T(m, m, 1);
+  CHECK(param_of([&] { T.apply(std::vector<double>(5)); }) == "values");
+  CHECK(param_of([&] { T.apply(std::vector<double>(25), 0); }) == "components");
+  CHECK(param_of([&] { T.apply(MatX(3, 1)); }) == "values");
+  CHECK(param_of([&] { PointLocator2D(m, -1); }) == "max_walk");
+  const PointLocator2D loc(m);
+  CHECK(param_of([&] { loc.locate(Vec<2>(std::nan(""), 0.0)); }) == "x");
+  CHECK(param_of([&] { loc.locate(Vec<2>(0.5, 0.5), nullptr, m.n_cells()); }) == "hint");
+}

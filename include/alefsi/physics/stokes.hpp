@@ -135,6 +135,29 @@ class StokesKernel {
   ReferenceTables<D, Pair> tab_;
 };
 
+/// Adds a constant to the pressure part of `field` so that the pressure has zero mean over
+/// the domain (the pressure of a flow with every boundary velocity prescribed).
+template <int D, ElementPair Pair>
+void shift_pressure_to_zero_mean(const MixedSpace<D, Pair>& space, VecX& field) {
+  using P = typename Pair::template Pressure<D>;
+  const auto& mesh = space.mesh();
+  const auto& rule = simplex_quadrature<D>(P::degree);
+  Real integral = 0, volume = 0;
+  for (Index c = 0; c < mesh.n_cells(); ++c) {
+    const Real m = mesh.measure(c) / reference_measure<D>;
+    const auto& dofs = space.pressure().cell_dofs(c);
+    for (int q = 0; q < rule.size(); ++q) {
+      const auto phi = P::values(rule.points[q]);
+      Real p = 0;
+      for (int b = 0; b < P::n_dofs; ++b) p += phi[b] * field[space.pressure_field(dofs[b])];
+      integral += rule.weights[q] * m * p;
+    }
+    volume += mesh.measure(c);
+  }
+  const Real mean = integral / volume;
+  for (Index k = 0; k < space.pressure().n_dofs(); ++k) field[space.pressure_field(k)] -= mean;
+}
+
 /// A steady Stokes problem on a fixed mesh: Dirichlet conditions by boundary tag, then solve.
 template <int D, ElementPair Pair>
 class Stokes {
@@ -188,25 +211,7 @@ class Stokes {
   }
 
   /// Adds a constant to the pressure so that its mean over the domain is zero.
-  void shift_pressure_to_zero_mean(VecX& field) const {
-    using P = typename Space::PressureElement;
-    const auto& mesh = space_.mesh();
-    const auto& rule = simplex_quadrature<D>(P::degree);
-    Real integral = 0, volume = 0;
-    for (Index c = 0; c < mesh.n_cells(); ++c) {
-      const Real m = mesh.measure(c) / reference_measure<D>;
-      const auto& dofs = space_.pressure().cell_dofs(c);
-      for (int q = 0; q < rule.size(); ++q) {
-        const auto phi = P::values(rule.points[q]);
-        Real p = 0;
-        for (int b = 0; b < P::n_dofs; ++b) p += phi[b] * field[space_.pressure_field(dofs[b])];
-        integral += rule.weights[q] * m * p;
-      }
-      volume += mesh.measure(c);
-    }
-    const Real mean = integral / volume;
-    for (Index k = 0; k < space_.pressure().n_dofs(); ++k) field[space_.pressure_field(k)] -= mean;
-  }
+  void shift_pressure_to_zero_mean(VecX& field) const { alefsi::shift_pressure_to_zero_mean(space_, field); }
 
  private:
   Space space_;

@@ -100,8 +100,9 @@ class AleFlow {
   /// Gravity: body force rho_f g on the fluid and M g on every free body.
   void set_gravity(const Vec<D>& g) { gravity_ = g; }
   /// Adds a rigid body (2D). Its surface facets carry `body.tag`; returns its index.
-  std::size_t add_body(const RigidBody2D& body) {
-    static_assert(D == 2, "rigid bodies are implemented in 2D so far");
+  std::size_t add_body(const RigidBody2D& body)
+    requires(D == 2)  // 3D bodies (6 DOF, quaternions) are not implemented yet
+  {
     require_not_started("add_body");
     body.validate(bodies_.size());
     ALEFSI_CHECK_ARG(!mesh_.boundary_nodes(body.tag).empty(), "body.tag", "no boundary facet has tag ", body.tag);
@@ -286,15 +287,16 @@ class AleFlow {
     }
     // bodies: centre and angle by the same formula with the extrapolated rigid velocity;
     // their surface nodes are placed by the exact rigid motion
-    for (auto& body : bodies_) {
-      Vec<D> xs = dt * body.Zhat.template head<D>();
-      Real ts = dt * body.Zhat[2];
-      for (int k = 1; k <= S::position_bdf; ++k) xs -= b[k] * body.xg[k - 1], ts -= b[k] * body.th[k - 1];
-      body.xg_next = xs / b[0];
-      body.th_next = ts / b[0];
-      for (std::size_t j = 0; j < body.nodes.size(); ++j)
-        Xn1[body.nodes[j]] = body.xg_next + rotate(body.r0[j], body.th_next - body.data.angle);
-    }
+    if constexpr (D == 2)
+      for (auto& body : bodies_) {
+        Vec<D> xs = dt * body.Zhat.template head<D>();
+        Real ts = dt * body.Zhat[2];
+        for (int k = 1; k <= S::position_bdf; ++k) xs -= b[k] * body.xg[k - 1], ts -= b[k] * body.th[k - 1];
+        body.xg_next = xs / b[0];
+        body.th_next = ts / b[0];
+        for (std::size_t j = 0; j < body.nodes.size(); ++j)
+          Xn1[body.nodes[j]] = body.xg_next + rotate(body.r0[j], body.th_next - body.data.angle);
+      }
     // mesh velocity the flow sees, and V^{n+1} for the next step
     std::vector<Vec<D>> Vflow = Vs, Vnext = Vs;
     if (S::velocity_level == VelocityLevel::n_half)
@@ -381,7 +383,7 @@ class AleFlow {
         throw SolverError("Newton did not converge in " + std::to_string(iters) + " iterations (residual " +
                           std::to_string(rn) + ")");
     }
-    if (pinned_) shift_pressure(field);
+    if (pinned_) shift_pressure_to_zero_mean(space_, field);
     for (auto& body : bodies_) {
       const Vec<3> Zn1 = body.data.free() ? Vec<3>(u.template segment<3>(cons_->extra_unknown(body.extra))) : body.data.prescribed(t1);
       if (body.data.free()) body.load = body_inertia<S>(body, Zn1, dt) - body_weight(body) - body.data_external();
@@ -443,19 +445,6 @@ class AleFlow {
       const Vec<3> m(body.data.mass, body.data.mass, body.data.inertia);
       for (int C = 0; C < 3; ++C) J_.coeffRef(e + C, e + C) += m[C] * a0 / dt;
     }
-  }
-
-  void shift_pressure(VecX& field) const {
-    Real integral = 0, volume = 0;
-    for (Index c = 0; c < mesh_.n_cells(); ++c) {
-      const auto& pd = space_.pressure().cell_dofs(c);
-      Real mean = 0;  // P1/P2 pressure: the vertex mean integrates P1 exactly
-      for (int b = 0; b <= D; ++b) mean += field[space_.pressure_field(pd[b])];
-      integral += mesh_.measure(c) * mean / (D + 1);
-      volume += mesh_.measure(c);
-    }
-    const Real m = integral / volume;
-    for (Index k = 0; k < space_.pressure().n_dofs(); ++k) field[space_.pressure_field(k)] -= m;
   }
 
   Mesh<D> mesh_;

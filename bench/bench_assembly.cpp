@@ -1,0 +1,384 @@
+// Benchmarks of steady-Stokes assembly and of the SparseLU direct solve, on the structured
+// unit square / unit cube: TaylorHood (P2/P1, "P2P1") and P1P1Gls ("P1P1GLS"), 2D and 3D.
+// Results and their discussion: docs/performance.md.
+//
+//   cmake --preset bench && cmake --build --preset bench --target bench_assembly
+//   bench/run_assembly.sh [assembly|lu|lu-long|all]
+//   build/bench/bench/bench_assembly --benchmark_filter='P2P1/2D/(kernel|assemble)/512/'
+//
+// Benchmarks (N = cells per side of rectangle_mesh / box_mesh):
+//   <pair>/<D>D/pattern/N    Assembler construction (cell DOF copy + CSR pattern + positions)
+//   <pair>/<D>D/kernel/N     gather + StokesKernel::cell over all cells, no scatter
+//   <pair>/<D>D/scatter/N    Assembler::scatter of one fixed element matrix/residual for every cell
+//   <pair>/<D>D/assemble/N   Assembler::assemble (zero J, gather, kernel, scatter), matrix + residual
+//   <pair>/<D>D/lu_<ord>/N   SparseLu<ord>: analyse, factorise, solve (times as counters), fill
+// Constraints as in Stokes::solve with every boundary tag Dirichlet: every velocity DOF on a
+// boundary facet fixed (lid velocity (1,0[,0]) on the top / ymax side, 0 elsewhere) and
+// pressure DOF 0 pinned. mu = 1, no body force. Single thread.
+//
+// Counters: cells, dofs (unknowns after constraints), nnz, el/s (cells * iterations per CPU
+// second, Google Benchmark's rate basis), GFLOP/s (kernel: the nominal flop count of
+// StokesKernel::cell, see flops_per_cell below), peak_MB (VmHWM of the process during that
+// benchmark: malloc_trim + /proc/self/clear_refs at its start, so it includes the problem, the
+// assembler and whatever the benchmark allocates).
+// LU: analyse_s, factorise_s, solve_s (wall clock) and *_cpu_s (thread CPU time), LU_nnz
+// (nonzeros of L + U), fill (LU_nnz / nnz), relres (||J x - b|| / ||b||).
+//
+// The problem (mesh, space, constraints, kernel, assembler) of the current size is cached
+// between the benchmarks of that size, which are registered size-major.
+#include <benchmark/benchmark.h>
+
+#include <malloc.h>
+#include <time.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "alefsi/fem/constraints.hpp"
+#include "alefsi/fem/dofmap.hpp"
+#include "alefsi/la/assembler.hpp"
+#include "alefsi/la/solvers.hpp"
+#include "alefsi/mesh/generate/structured.hpp"
+#include "alefsi/physics/stokes.hpp"
+
+namespace {
+
+using namespace alefsi;
+
+// ---- memory --------------------------------------------------------------------------
+// Returns freed heap to the OS and resets the process's peak RSS (VmHWM) to its current RSS.
+void reset_peak_rss() {
+  malloc_trim(0);
+  std::ofstream f("/proc/self/clear_refs");
+  f << "5";
+}
+double status_mb(const char* key) {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  const std::size_t n = std::strlen(key);
+  while (std::getline(f, line))
+    if (line.compare(0, n, key) == 0) return std::stod(line.substr(n + 1)) / 1024.0;  // kB -> MB
+  return -1;
+}
+double peak_mb() { return status_mb("VmHWM:"); }
+
+// ---- the problem -----------------------------------------------------------------------
+// short names for the benchmark labels (no '/', so that filters stay simple)
+template <class Pair>
+constexpr const char* label = std::is_same_v<Pair, TaylorHood> ? "P2P1" : "P1P1GLS";
+
+template <int D>
+Mesh<D> make_mesh(int n) {
+  if constexpr (D == 2)
+    return rectangle_mesh(n, n);
+  else
+    return box_mesh(n, n, n);
+}
+
+template <int D, class Pair>
+struct Problem {
+  using Space = MixedSpace<D, Pair>;
+  using Kernel = StokesKernel<D, Pair>;
+  using Asm = Assembler<Space::n_local>;
+  static constexpr int lid_tag = D == 2 ? tags::top : tags::ymax;
+
+  explicit Problem(int n) : mesh(make_mesh<D>(n)), space(mesh), cons(space.n_field()), kernel(space, 1.0) {
+    const auto& vel = space.velocity();
+    std::vector<char> done(vel.n_dofs(), 0);
+    // the lid first so that its edge/corner DOFs take the lid value, as in a driven cavity
+    std::vector<int> tag_order{lid_tag};
+    for (int t = 1; t <= 2 * D; ++t)
+      if (t != lid_tag) tag_order.push_back(t);
+    for (int t : tag_order)
+      for (Index i : vel.boundary_dofs(t)) {
+        if (done[i]) continue;
+        done[i] = 1;
+        for (int k = 0; k < D; ++k) cons.fix(space.velocity_field(i, k), (t == lid_tag && k == 0) ? 1.0 : 0.0);
+      }
+    cons.fix(space.pressure_field(0), 0.0);
+    cons.finalize();
+    field = cons.expand(VecX::Zero(cons.n_unknowns()));
+  }
+
+  std::unique_ptr<Asm> build_assembler() const {
+    return std::make_unique<Asm>(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
+  }
+  Asm& assembler() {
+    if (!asmb) asmb = build_assembler();
+    return *asmb;
+  }
+
+  Mesh<D> mesh;
+  Space space;
+  DofConstraints cons;
+  Kernel kernel;
+  VecX field;
+  std::unique_ptr<Asm> asmb;
+};
+
+// One problem alive at a time (type-erased), rebuilt when the (D, pair, N) key changes.
+std::shared_ptr<void> g_problem;
+std::string g_key;
+
+template <int D, class Pair>
+std::string problem_key(int n) {
+  return std::string(label<Pair>) + "/" + std::to_string(D) + "/" + std::to_string(n);
+}
+
+// Call at the start of a benchmark: drops the cached problem if it is another one, then
+// resets the peak RSS, then returns the (possibly new) problem. peak_MB thus covers what the
+// benchmark holds: its problem (built now or cached) and what it allocates itself.
+template <int D, class Pair>
+Problem<D, Pair>& problem(int n) {
+  const std::string key = problem_key<D, Pair>(n);
+  if (key != g_key) {
+    g_problem.reset();
+    g_key.clear();
+  }
+  reset_peak_rss();
+  if (key != g_key) {
+    g_problem = std::make_shared<Problem<D, Pair>>(n);
+    g_key = key;
+  }
+  return *static_cast<Problem<D, Pair>*>(g_problem.get());
+}
+
+// ---- nominal flop count of StokesKernel::cell --------------------------------------------
+// Counted from the loops as written (one flop per + - *, a multiply-add = 2 flops), with the
+// loop-invariant w * mu (and w * tau) hoisted once per quadrature point; no body force (the
+// velocity load loop is skipped; the GLS load loop still runs with fq = 0). Per quadrature
+// point q:
+//   G = dphi_v[q] * Jinv                     2 nv D^2
+//   viscous (a, b):  dot 2D, * 1, diag +D, off-diag D^2 * (2 mul + 1 add)
+//                                            nv^2 (3D + 1 + 3D^2)
+//   divergence (a, b, i): -w php G, two +=   4 nv np D
+//   GLS: Gp 2 np D^2; pressure block np^2 (2D + 2); load np (2D + 2)
+// Per cell: J (D^2 subtractions), inverse + determinant (~10 in 2D, ~50 in 3D), r = A u - F
+// (2 n^2). The quadrature has 12 (2D) / 24 (3D) points for P2/P1 (degree 6), 6 / 14 for
+// P1/P1 (degree 4).
+template <int D, class Pair>
+double flops_per_cell() {
+  using K = StokesKernel<D, Pair>;
+  constexpr double nv = K::nv, np = K::np, n = K::n_local, d = D;
+  const int nq = simplex_quadrature<D>(2 * K::V::degree + 2).size();
+  double per_q = 2 * nv * d * d + nv * nv * (3 * d + 1 + 3 * d * d) + 4 * nv * np * d;
+  if (Pair::stabilised) per_q += 2 * np * d * d + np * np * (2 * d + 2) + np * (2 * d + 2);
+  const double per_cell = d * d + (D == 2 ? 10 : 50) + 2 * n * n;
+  return nq * per_q + per_cell;
+}
+
+// ||J x - b|| / ||b|| with plain loops (Eigen's AVX-512 norm() trips GCC 12's
+// -Wmaybe-uninitialized inside the intrinsics headers, an error under -Werror).
+double rel_residual(const SparseMatrix& J, const VecX& x, const VecX& b) {
+  VecX res = -b;
+  for (Index j = 0; j < J.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(J, j); it; ++it) res[it.row()] += it.value() * x[j];
+  double rr = 0, bb = 0;
+  for (Index i = 0; i < b.size(); ++i) rr += res[i] * res[i], bb += b[i] * b[i];
+  return std::sqrt(rr / bb);
+}
+
+template <class Asm>
+void size_counters(benchmark::State& state, const Asm& asmb) {
+  state.counters["cells"] = double(asmb.n_cells());
+  state.counters["dofs"] = double(asmb.n_unknowns());
+  state.counters["nnz"] = double(asmb.matrix().nonZeros());
+}
+
+// ---- benchmarks ----------------------------------------------------------------------------
+template <int D, class Pair>
+void bm_pattern(benchmark::State& state, int n) {
+  auto& p = problem<D, Pair>(n);
+  for (auto _ : state) {
+    state.PauseTiming();
+    p.asmb.reset();  // release the previous pattern outside the timing
+    state.ResumeTiming();
+    p.asmb = p.build_assembler();
+    benchmark::DoNotOptimize(p.asmb->matrix().valuePtr());
+  }
+  size_counters(state, *p.asmb);
+  const double n_local = Problem<D, Pair>::Space::n_local;
+  state.counters["pos_MB"] = double(p.asmb->n_cells()) * n_local * n_local * sizeof(Index) / 1048576.0;
+  state.counters["matrix_MB"] =
+      double(p.asmb->matrix().nonZeros()) * (sizeof(Real) + sizeof(Index)) / 1048576.0;
+  state.counters["peak_MB"] = peak_mb();
+}
+
+template <int D, class Pair>
+void bm_kernel(benchmark::State& state, int n) {
+  auto& p = problem<D, Pair>(n);
+  const auto& asmb = p.assembler();
+  typename Problem<D, Pair>::Asm::LocalMat A;
+  typename Problem<D, Pair>::Asm::LocalVec r;
+  for (auto _ : state) {
+    for (Index c = 0; c < asmb.n_cells(); ++c) {
+      const auto u = asmb.gather(c, p.field);
+      p.kernel.cell(c, u, A, r);
+      benchmark::DoNotOptimize(A.data());
+      benchmark::DoNotOptimize(r.data());
+    }
+    benchmark::ClobberMemory();
+  }
+  size_counters(state, asmb);
+  const double el = double(asmb.n_cells()) * double(state.iterations());
+  state.counters["el/s"] = benchmark::Counter(el, benchmark::Counter::kIsRate);
+  state.counters["GFLOP/s"] = benchmark::Counter(el * flops_per_cell<D, Pair>() * 1e-9, benchmark::Counter::kIsRate);
+  state.counters["flop/el"] = flops_per_cell<D, Pair>();
+  state.counters["peak_MB"] = peak_mb();
+}
+
+template <int D, class Pair>
+void bm_scatter(benchmark::State& state, int n) {
+  auto& p = problem<D, Pair>(n);
+  const auto& asmb = p.assembler();
+  SparseMatrix J = asmb.matrix();
+  VecX r = VecX::Zero(asmb.n_unknowns());
+  // one realistic element matrix (cell 0's) scattered by every cell
+  typename Problem<D, Pair>::Asm::LocalMat A;
+  typename Problem<D, Pair>::Asm::LocalVec re;
+  p.kernel.cell(0, asmb.gather(0, p.field), A, re);
+  for (auto _ : state) {
+    for (Index c = 0; c < asmb.n_cells(); ++c) asmb.scatter(c, A, re, J.valuePtr(), &r);
+    benchmark::DoNotOptimize(J.valuePtr());
+    benchmark::DoNotOptimize(r.data());
+    benchmark::ClobberMemory();
+  }
+  size_counters(state, asmb);
+  state.counters["el/s"] =
+      benchmark::Counter(double(asmb.n_cells()) * double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["peak_MB"] = peak_mb();
+}
+
+template <int D, class Pair>
+void bm_assemble(benchmark::State& state, int n) {
+  auto& p = problem<D, Pair>(n);
+  const auto& asmb = p.assembler();
+  SparseMatrix J = asmb.matrix();  // as in Stokes::solve: a separate matrix with the pattern
+  VecX r;
+  for (auto _ : state) {
+    asmb.assemble(p.kernel, p.field, &J, &r);
+    benchmark::DoNotOptimize(J.valuePtr());
+    benchmark::DoNotOptimize(r.data());
+  }
+  size_counters(state, asmb);
+  state.counters["el/s"] =
+      benchmark::Counter(double(asmb.n_cells()) * double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["peak_MB"] = peak_mb();
+}
+
+template <int D, class Pair, class Ordering>
+void bm_lu(benchmark::State& state, int n) {
+  using clock = std::chrono::steady_clock;
+  auto secs = [](clock::time_point a, clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
+  auto cpu = [] {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+  };
+  auto& p = problem<D, Pair>(n);
+  const auto& asmb = p.assembler();
+  SparseMatrix J = asmb.matrix();
+  VecX r;
+  asmb.assemble(p.kernel, p.field, &J, &r);
+  const VecX b = -r;
+  double ta = 0, tf = 0, ts = 0, ca = 0, cf = 0, cs = 0, lu_nnz = 0, relres = 0;
+  for (auto _ : state) {
+    SparseLu<Ordering> lu;
+    const double c0 = cpu();
+    const auto t0 = clock::now();
+    lu.analyze(J);
+    const double c1 = cpu();
+    const auto t1 = clock::now();
+    lu.factorize(J);
+    const double c2 = cpu();
+    const auto t2 = clock::now();
+    const VecX x = lu.solve(b);
+    const double c3 = cpu();
+    const auto t3 = clock::now();
+    ta += secs(t0, t1), tf += secs(t1, t2), ts += secs(t2, t3);
+    ca += c1 - c0, cf += c2 - c1, cs += c3 - c2;
+    state.PauseTiming();
+    lu_nnz = double(lu.factor_nonzeros());
+    relres = rel_residual(J, x, b);
+    state.ResumeTiming();
+  }
+  size_counters(state, asmb);
+  const double it = double(state.iterations());
+  state.counters["analyse_s"] = ta / it;
+  state.counters["factorise_s"] = tf / it;
+  state.counters["solve_s"] = ts / it;
+  state.counters["analyse_cpu_s"] = ca / it;
+  state.counters["factorise_cpu_s"] = cf / it;
+  state.counters["solve_cpu_s"] = cs / it;
+  state.counters["LU_nnz"] = lu_nnz;
+  state.counters["fill"] = lu_nnz / double(J.nonZeros());
+  state.counters["relres"] = relres;
+  state.counters["peak_MB"] = peak_mb();
+}
+
+// ---- registration ----------------------------------------------------------------------------
+// Sizes. 2D: rectangle_mesh(N, N); 3D: box_mesh(N, N, N). 3D P2/P1: N = 32 has 0.82 M
+// unknowns, N = 36 has 1.17 M; 3D P1/P1: N = 64 has 1.03 M.
+const std::vector<int> sizes_2d{64, 128, 256, 512};
+const std::vector<int> sizes_3d_th{8, 16, 24, 32, 36};
+const std::vector<int> sizes_3d_p1{16, 32, 48, 64};
+// SparseLU sizes (COLAMD): 2D P2/P1 N = 256 is the long one (minutes; DESIGN.md: 134 s).
+const std::vector<int> lu_2d_th{16, 32, 64, 128, 256};
+const std::vector<int> lu_2d_p1{64, 128, 256};
+const std::vector<int> lu_3d_th{4, 6, 8, 10, 12};   // N = 12: 49 k unknowns
+const std::vector<int> lu_3d_p1{8, 12, 16, 22};     // N = 22: 49 k unknowns
+const std::vector<int> lu_amd_2d_th{8, 16, 32};     // AMD(A + A^T): the bad one
+
+template <int D, class Pair>
+void register_assembly(const std::vector<int>& sizes) {
+  const std::string base = std::string(label<Pair>) + "/" + std::to_string(D) + "D/";
+  for (int n : sizes) {
+    const std::string s = "/" + std::to_string(n);
+    // big cases run once (MinTime: the first iteration already exceeds it)
+    benchmark::RegisterBenchmark((base + "pattern" + s).c_str(), bm_pattern<D, Pair>, n)
+        ->Unit(benchmark::kMillisecond)->MinTime(0.3);
+    benchmark::RegisterBenchmark((base + "kernel" + s).c_str(), bm_kernel<D, Pair>, n)
+        ->Unit(benchmark::kMillisecond)->MinTime(0.3);
+    benchmark::RegisterBenchmark((base + "scatter" + s).c_str(), bm_scatter<D, Pair>, n)
+        ->Unit(benchmark::kMillisecond)->MinTime(0.3);
+    benchmark::RegisterBenchmark((base + "assemble" + s).c_str(), bm_assemble<D, Pair>, n)
+        ->Unit(benchmark::kMillisecond)->MinTime(0.3);
+  }
+}
+
+template <int D, class Pair, class Ordering>
+void register_lu(const char* ord, const std::vector<int>& sizes) {
+  const std::string base = std::string(label<Pair>) + "/" + std::to_string(D) + "D/lu_" + ord + "/";
+  for (int n : sizes)
+    benchmark::RegisterBenchmark((base + std::to_string(n)).c_str(), bm_lu<D, Pair, Ordering>, n)
+        ->Unit(benchmark::kMillisecond)->Iterations(1);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using Colamd = Eigen::COLAMDOrdering<Index>;
+  using Amd = Eigen::AMDOrdering<Index>;
+  register_assembly<2, TaylorHood>(sizes_2d);
+  register_assembly<2, P1P1Gls>(sizes_2d);
+  register_assembly<3, TaylorHood>(sizes_3d_th);
+  register_assembly<3, P1P1Gls>(sizes_3d_p1);
+  register_lu<2, TaylorHood, Colamd>("colamd", lu_2d_th);
+  register_lu<2, TaylorHood, Amd>("amd", lu_amd_2d_th);
+  register_lu<2, P1P1Gls, Colamd>("colamd", lu_2d_p1);
+  register_lu<3, TaylorHood, Colamd>("colamd", lu_3d_th);
+  register_lu<3, P1P1Gls, Colamd>("colamd", lu_3d_p1);
+  // Eigen::MetisOrdering needs metis.h (libmetis-dev), which is not installed here.
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -254,3 +254,19 @@ TEMPLATE_TEST_CASE("steady Navier-Stokes (Kovasznay, Re = 40): spatial rates", "
   CHECK(observed_rate(N0, e0.u_h1, N1, e1.u_h1, 2) == Approx(th ? 2.0 : 1.0).margin(0.15));
   CHECK(observed_rate(N0, e0.p_l2, N1, e1.p_l2, 2) >= (th ? 1.85 : 1.4));
 }
+
+TEST_CASE("a step whose Newton iteration fails is rejected and leaves the state at t^n", "[ale][quick]") {
+  using Ex = Exact<2, TaylorHood>;
+  AleFlow<2, TaylorHood, BDF2_BDF2E> flow(rectangle_mesh(4, 4), FlowOptions{rho, 0.01, Linearisation::newton, 1, 1e-14});
+  for (int t = 1; t <= 4; ++t) flow.set_velocity(t, Ex::u);
+  flow.set_prescribed_mesh_velocity(wobble<2>);
+  flow.set_force([](const Vec<2>& x, Real t) { return Vec<2>(40 * Ex::f(x, t)); });
+  flow.set_initial_velocity([](const Vec<2>& x) { return Ex::u(x, 0.0); });
+  const auto x0 = flow.mesh().coordinates();
+  const VecX u0 = flow.field();
+  REQUIRE_THROWS_WITH(flow.step(0.2), Catch::Contains("Newton did not converge"));
+  CHECK(flow.time() == 0.0);
+  CHECK(flow.field() == u0);
+  for (Index i = 0; i < flow.mesh().n_nodes(); ++i) CHECK(flow.mesh().node(i) == x0[i]);
+  REQUIRE_THROWS_AS(flow.step(-1.0), InvalidArgument);
+}

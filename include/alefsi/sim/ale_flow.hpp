@@ -26,6 +26,7 @@
 ///     for (int n = 0; n < 100; ++n) flow.step(0.01);
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <functional>
 #include <map>
 #include <memory>
@@ -360,28 +361,35 @@ class AleFlow {
     VecX field = cons_->expand(u);
     VecX r;
     Real r0 = -1;
-    const int iters = opt_.linearisation == Linearisation::newton ? opt_.max_newton : 1;
-    for (int it = 0; it < iters; ++it) {
-      asmb_->assemble(kernel_, field, &J_, &r);
-      add_body_rows<S>(dt, u, r);
-      lap(rep.t_assembly);
-      const Real rn = r.size() ? r.lpNorm<Eigen::Infinity>() : 0.0;
-      rep.residuals.push_back(rn);
-      if (r0 < 0) r0 = rn;
-      if (opt_.linearisation == Linearisation::newton && it > 0 && rn <= opt_.newton_tolerance * r0 + 1e-13) break;
-      if (!analysed_) {
-        solver_.analyze(J_);
-        analysed_ = true;
+    const bool newton = opt_.linearisation == Linearisation::newton;
+    try {
+      for (int it = 0;; ++it) {
+        asmb_->assemble(kernel_, field, &J_, &r);
+        add_body_rows<S>(dt, u, r);
+        lap(rep.t_assembly);
+        const Real rn = r.size() ? r.lpNorm<Eigen::Infinity>() : 0.0;
+        rep.residuals.push_back(rn);
+        if (!std::isfinite(rn)) throw SolverError("non-finite residual at Newton iteration " + std::to_string(it));
+        if (r0 < 0) r0 = rn;
+        if (newton && it > 0 && rn <= opt_.newton_tolerance * r0 + 1e-13) break;
+        if (newton && it == opt_.max_newton)
+          throw SolverError("Newton did not converge in " + std::to_string(it) + " iterations (residual " +
+                            std::to_string(rn) + ", first " + std::to_string(r0) + ")");
+        if (!analysed_) {
+          solver_.analyze(J_);
+          analysed_ = true;
+        }
+        solver_.factorize(J_);
+        lap(rep.t_factorize);
+        u -= solver_.solve(r);
+        lap(rep.t_solve);
+        field = cons_->expand(u);
+        ++rep.newton_iterations;
+        if (!newton) break;
       }
-      solver_.factorize(J_);
-      lap(rep.t_factorize);
-      u -= solver_.solve(r);
-      lap(rep.t_solve);
-      field = cons_->expand(u);
-      ++rep.newton_iterations;
-      if (opt_.linearisation == Linearisation::newton && it + 1 == iters)
-        throw SolverError("Newton did not converge in " + std::to_string(iters) + " iterations (residual " +
-                          std::to_string(rn) + ")");
+    } catch (...) {
+      mesh_.set_coordinates(X_[0]);  // the step is rejected: the state stays at t^n
+      throw;
     }
     if (pinned_) shift_pressure_to_zero_mean(space_, field);
     for (auto& body : bodies_) {

@@ -1,0 +1,407 @@
+// Largest stable time step of each ALE scheme on a reference problem, by bisection.
+//
+//   g++ -std=c++20 -O3 -march=native -DNDEBUG -Iinclude -I/usr/include/eigen3 bench/ale_stability.cpp -o /tmp/ale_stability
+//   /tmp/ale_stability [--schemes MR_AB,BDF2_BDF2E,BDF2_AB,BDF3_BDF3E,BSS] [--h 0.05] [--mu 1,0.01]
+//                      [--T 2] [--min-steps 200] [--dt-lo 0.005] [--dt-hi 0.5] [--tol 0.02]
+//                      [--lin newton|semi] [--mesh-motion shear|rigid] [--max-drift D] [--csv FILE]
+//                      [--trace DT]
+//
+// Problem (the annulus of the paper's Figure 7 set-up, WITHOUT the free inner body): fluid in
+// R1 = 0.25 < |x| < R2 = 1, rho = 1, mu from --mu (each value is a separate table row); the
+// outer cylinder turns at omega = 1 rad/s (u = omega (-y, x) on the outer wall, from t = 0:
+// impulsive start), the inner cylinder is a fixed no-slip wall (u = 0; rigid bodies are not in
+// AleFlow yet), fluid initially at rest. P1/P1-GLS on annulus_unstructured(R1, R2, h).
+// Mesh motion (--mesh-motion):
+//   shear (default): the outer-wall nodes move with the wall (set_mesh_velocity(outer) = the
+//       rotation velocity), the inner-wall nodes stay, the interior follows the elasticity
+//       problem: every step runs the mesh-velocity solve, and the mesh shears (the outer ring
+//       turns by omega t against the fixed inner ring). At h = 0.05 the smallest cell quality
+//       falls from 0.63 to 0.03 by t = 2 s and a cell inverts near t = 6.3-6.7 s for every dt
+//       (the motion, not the scheme), so any run longer than ~6 s ends with "mesh";
+//   rigid: the inner-wall nodes also get the rotation velocity (they slide along the fixed inner
+//       wall, whose fluid velocity stays 0), so the elasticity solution is the rigid rotation
+//       and the mesh turns without distortion; runs of any length are possible.
+// The wall nodes are advanced by the scheme's position formula (delta_lg X^{n+1} = dt V with V
+// evaluated on the extrapolated positions), not placed on their circles, so they drift off
+// them: the position update is an explicit integrator of dX/dt = omega x X (BSS: forward Euler,
+// radius * sqrt(1 + (omega dt)^2) per step). The drift max ||X_v| - R| over the wall nodes is
+// monitored and is a failure criterion (below).
+//
+// "Stable" at dt: the run reaches max(T, min_steps * dt) (default max(2 s, 200 steps)) and none
+// of these happens at any step:
+//   newton   Newton does not converge (25 iterations, relative residual 1e-10), or SparseLU fails;
+//   blow-up  a non-finite value, or max |u_h| > 10 x the maximal wall speed (omega R2 = 1);
+//   energy   after the start-up (step n >= 10 and t >= 10 x the diffusive time h^2 rho / mu,
+//            capped at 1 s) the kinetic energy grows by more than 10 % in one step,
+//            E^{n+1} > 1.1 E^n (a spin-up from rest grows slower than that once the start-up
+//            transient is over);
+//   drift    a wall node is more than --max-drift (default h; 0 disables) off its circle: the
+//            domain is no longer the annulus (at dt = 0.5 BDF3/BDF3E shrinks the whole mesh
+//            towards the centre while the flow criteria stay quiet, so this one is needed);
+//   E-bound  only with --energy-bound F (off by default; the tables in docs/ale_benchmarks.md
+//            were measured without it): E > F x E_max, E_max = 1/2 rho |Omega| (omega R2)^2, the
+//            energy of the whole fluid at the largest wall speed (|u| <= omega R2 for this flow).
+//            Catches slow energy growth the 10 %-per-step test misses (MR/AB, mu = 0.01).
+//   mesh     a cell is inverted or degenerate, or the elasticity matrix is not SPD. This is a
+//            failure of the mesh motion, not of the time scheme; it is reported separately
+//            and counted as "not stable" by the bisection (the table says so).
+// Bisection: dt_hi (--dt-hi) is tried first (stable: the result is ">= dt_hi"), then dt_lo
+// (unstable: "< dt_lo"); then geometric bisection dt = sqrt(lo hi) until hi / lo <= 1 + tol
+// (default 2 %); the result is lo, the largest dt found stable. It assumes stability is
+// monotone in dt, which bisection cannot check.
+//
+// This is NOT yet the paper's set-up: the paper's critical steps (0.06, 0.110, 0.108, 0.113,
+// 0.025 for MR/AB, BDF2/BDF2E, BDF2/AB, BDF3/BDF3E, BSS) are for h = 0.01 with a FREE inner
+// body coupled to the flow; here the inner wall is fixed.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "alefsi/mesh/generate/mesher2d.hpp"
+#include "alefsi/sim/ale_flow.hpp"
+
+namespace {
+
+using namespace alefsi;
+using Clock = std::chrono::steady_clock;
+
+constexpr Real R1 = 0.25, R2 = 1.0, omega = 1.0, rho = 1.0;
+constexpr Real wall_speed = omega * R2;
+
+struct Settings {
+  Real h = 0.05, T = 2, dt_lo = 0.005, dt_hi = 0.5, tol = 0.02;
+  int min_steps = 200, startup_steps = 10;
+  Linearisation lin = Linearisation::newton;
+  Real max_drift = -1;  // < 0: h; 0: no drift criterion
+  Real energy_bound = 0;  // > 0: unstable if E > energy_bound * E_max (opt-in, see the header)
+  bool rigid = false;  // --mesh-motion rigid: the inner-wall nodes slide with the rotation too
+  Real trace_dt = 0;  // > 0: one verbose run at this dt per scheme and mu, no bisection
+};
+
+enum class Outcome { stable, newton, blowup, energy, bound, drift, mesh };
+const char* outcome_name(Outcome o) {
+  switch (o) {
+    case Outcome::stable: return "stable";
+    case Outcome::newton: return "newton";
+    case Outcome::blowup: return "blow-up";
+    case Outcome::energy: return "energy";
+    case Outcome::bound: return "E-bound";
+    case Outcome::drift: return "drift";
+    case Outcome::mesh: return "mesh";
+  }
+  return "?";
+}
+
+struct Probe {
+  Real dt = 0;
+  Outcome outcome = Outcome::stable;
+  int steps = 0, target = 0;
+  Real t = 0, umax = 0, energy = 0, energy_max = 0, drift = 0, min_quality = 1, wall = 0;
+  std::string detail;
+};
+
+// Kinetic energy 1/2 rho int |u|^2 of the P1 velocity (exact P1 mass matrix) and max |u| at
+// the velocity DOFs.
+template <class Flow>
+std::pair<Real, Real> energy_and_umax(const Flow& flow) {
+  const auto& sp = flow.space();
+  const auto& mesh = flow.mesh();
+  const VecX& f = flow.field();
+  auto vel = [&](Index i) { return Vec<2>(f[sp.velocity_field(i, 0)], f[sp.velocity_field(i, 1)]); };
+  Real E = 0, umax = 0;
+  for (Index c = 0; c < mesh.n_cells(); ++c) {
+    const auto& d = sp.velocity().cell_dofs(c);
+    Real s2 = 0;
+    Vec<2> sum = Vec<2>::Zero();
+    for (int a = 0; a < 3; ++a) {
+      const Vec<2> ua = vel(d[a]);
+      s2 += ua.squaredNorm();
+      sum += ua;
+    }
+    E += mesh.measure(c) / 12 * (s2 + sum.squaredNorm());
+  }
+  for (Index i = 0; i < sp.velocity().n_dofs(); ++i) {
+    const Vec<2> ui = vel(i);
+    if (!std::isfinite(ui[0]) || !std::isfinite(ui[1])) return {NAN, INFINITY};
+    umax = std::max(umax, ui.norm());
+  }
+  return {0.5 * rho * E, umax};
+}
+
+template <class Scheme>
+Probe probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool trace) {
+  const auto t0 = Clock::now();
+  Probe p;
+  p.dt = dt;
+  p.target = std::max(s.min_steps, int(std::ceil(s.T / dt - 1e-9)));
+  // energy check from here on: n >= startup_steps and t >= 10 h^2 rho / mu (<= 1 s)
+  const Real t_startup = std::min(1.0, 10 * s.h * s.h * rho / mu);
+  AleFlow<2, P1P1Gls, Scheme> flow(mesh0, FlowOptions{rho, mu, s.lin, 25, 1e-10});
+  auto rotation = [](const Vec<2>& x, Real) { return Vec<2>(-omega * x[1], omega * x[0]); };
+  flow.set_velocity(tags::outer, rotation);
+  flow.set_velocity(tags::inner, [](const Vec<2>&, Real) { return Vec<2>(Vec<2>::Zero()); });
+  flow.set_mesh_velocity(tags::outer, rotation);
+  if (s.rigid) flow.set_mesh_velocity(tags::inner, rotation);  // nodes slide along the fixed inner wall
+  const std::vector<Index> outer = flow.mesh().boundary_nodes(tags::outer), inner = flow.mesh().boundary_nodes(tags::inner);
+  const Real max_drift = s.max_drift < 0 ? s.h : s.max_drift;
+  // |u| <= omega R2 for this flow, so E <= E_cap = 1/2 rho |Omega| (omega R2)^2
+  Real area = 0;
+  for (Index c = 0; c < mesh0.n_cells(); ++c) area += mesh0.measure(c);
+  const Real E_cap = 0.5 * rho * area * wall_speed * wall_speed;
+  Real E_prev = 0;
+  for (int n = 0; n < p.target; ++n) {
+    try {
+      flow.step(dt);
+    } catch (const MeshError& e) {
+      p.outcome = Outcome::mesh, p.detail = e.what();
+      break;
+    } catch (const SolverError& e) {
+      const std::string w = e.what();
+      p.outcome = w.find("mesh-velocity") != std::string::npos ? Outcome::mesh : Outcome::newton;
+      p.detail = w;
+      break;
+    }
+    p.steps = n + 1;
+    p.t = flow.time();
+    const auto [E, umax] = energy_and_umax(flow);
+    p.umax = std::max(p.umax, umax);
+    p.energy = E;
+    p.energy_max = std::max(p.energy_max, E);
+    for (Index v : outer) p.drift = std::max(p.drift, std::abs(flow.mesh().node(v).norm() - R2));
+    for (Index v : inner) p.drift = std::max(p.drift, std::abs(flow.mesh().node(v).norm() - R1));
+    if (trace && (n < 12 || (n + 1) % std::max(1, p.target / 40) == 0)) {
+      Real q = 1;
+      for (Index c = 0; c < flow.mesh().n_cells(); ++c) q = std::min(q, flow.mesh().quality(c));
+      std::printf("    n=%4d t=%8.4f E=%.6e umax=%.4f E/Eprev=%.4f drift=%.2e minq=%.3f\n", n + 1, p.t, E, umax,
+                  E_prev > 0 ? E / E_prev : 0.0, p.drift, q);
+    }
+    if (!std::isfinite(E) || umax > 10 * wall_speed) {
+      p.outcome = Outcome::blowup;
+      p.detail = "max |u| = " + std::to_string(umax);
+      break;
+    }
+    if (s.energy_bound > 0 && E > s.energy_bound * E_cap) {
+      p.outcome = Outcome::bound;
+      p.detail = "E = " + std::to_string(E) + " > " + std::to_string(s.energy_bound) + " x E_max = " + std::to_string(E_cap);
+      break;
+    }
+    if (max_drift > 0 && p.drift > max_drift) {
+      p.outcome = Outcome::drift;
+      p.detail = "wall nodes " + std::to_string(p.drift) + " off their circle";
+      break;
+    }
+    if (n + 1 > s.startup_steps && p.t >= t_startup && E > 1.1 * E_prev) {
+      p.outcome = Outcome::energy;
+      p.detail = "E^{n+1}/E^n = " + std::to_string(E / E_prev);
+      break;
+    }
+    E_prev = E;
+  }
+  for (Index c = 0; c < flow.mesh().n_cells(); ++c) p.min_quality = std::min(p.min_quality, flow.mesh().quality(c));
+  p.wall = std::chrono::duration<double>(Clock::now() - t0).count();
+  return p;
+}
+
+struct Result {
+  std::string scheme;
+  Real mu = 0;
+  std::string dt_max;       // "0.123", ">= 0.5", "< 0.005"
+  Real lo = 0, hi = 0;      // bracket
+  Probe first_unstable;     // the failing probe closest to the threshold
+  Probe last_stable;
+  int probes = 0;
+  double wall = 0;
+};
+
+void print_probe(const Probe& p) {
+  std::printf("  dt=%.5f %-8s steps %4d/%-4d t=%7.3f umax=%.3f E=%.4e Emax=%.4e drift=%.1e minq=%.3f (%.1f s)%s%s\n",
+              p.dt, outcome_name(p.outcome), p.steps, p.target, p.t, p.umax, p.energy, p.energy_max, p.drift,
+              p.min_quality, p.wall,
+              p.detail.empty() ? "" : "  ", p.detail.c_str());
+  std::fflush(stdout);
+}
+
+template <class Scheme>
+Result bisect(const Mesh<2>& mesh, Real mu, const Settings& s) {
+  const auto t0 = Clock::now();
+  Result r;
+  r.scheme = Scheme::name, r.mu = mu;
+  std::printf("%s, mu = %g:\n", Scheme::name, mu);
+  auto run = [&](Real dt) {
+    ++r.probes;
+    Probe p = probe<Scheme>(mesh, mu, dt, s, false);
+    print_probe(p);
+    return p;
+  };
+  Probe hi = run(s.dt_hi);
+  if (hi.outcome == Outcome::stable) {
+    r.dt_max = ">= " + std::to_string(s.dt_hi);
+    r.lo = r.hi = s.dt_hi, r.last_stable = hi;
+  } else {
+    Probe lo = run(s.dt_lo);
+    if (lo.outcome != Outcome::stable) {
+      r.dt_max = "< " + std::to_string(s.dt_lo);
+      r.lo = r.hi = s.dt_lo, r.first_unstable = lo;
+    } else {
+      while (hi.dt / lo.dt > 1 + s.tol) {
+        Probe m = run(std::sqrt(lo.dt * hi.dt));
+        (m.outcome == Outcome::stable ? lo : hi) = m;
+      }
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.4f", lo.dt);
+      r.dt_max = buf, r.lo = lo.dt, r.hi = hi.dt, r.last_stable = lo, r.first_unstable = hi;
+    }
+  }
+  r.wall = std::chrono::duration<double>(Clock::now() - t0).count();
+  return r;
+}
+
+using BisectFn = Result (*)(const Mesh<2>&, Real, const Settings&);
+using ProbeFn = Probe (*)(const Mesh<2>&, Real, Real, const Settings&, bool);
+struct SchemeEntry {
+  const char* key;
+  BisectFn bisect;
+  ProbeFn probe;
+};
+const std::vector<SchemeEntry> all_schemes{
+    {"MR_AB", bisect<MR_AB>, probe<MR_AB>},
+    {"BDF2_BDF2E", bisect<BDF2_BDF2E>, probe<BDF2_BDF2E>},
+    {"BDF2_AB", bisect<BDF2_AB>, probe<BDF2_AB>},
+    {"BDF3_BDF3E", bisect<BDF3_BDF3E>, probe<BDF3_BDF3E>},
+    {"BSS", bisect<BSS>, probe<BSS>},
+};
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Settings s;
+  std::vector<std::string> schemes{"MR_AB", "BDF2_BDF2E", "BDF2_AB", "BDF3_BDF3E", "BSS"};
+  std::vector<Real> mus{1.0, 0.01};
+  std::string csv;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--schemes") schemes = split(next());
+    else if (a == "--h") s.h = std::atof(next().c_str());
+    else if (a == "--mu") {
+      mus.clear();
+      for (const auto& m : split(next())) mus.push_back(std::atof(m.c_str()));
+    } else if (a == "--T") s.T = std::atof(next().c_str());
+    else if (a == "--min-steps") s.min_steps = std::atoi(next().c_str());
+    else if (a == "--dt-lo") s.dt_lo = std::atof(next().c_str());
+    else if (a == "--dt-hi") s.dt_hi = std::atof(next().c_str());
+    else if (a == "--tol") s.tol = std::atof(next().c_str());
+    else if (a == "--lin") {
+      const std::string l = next();
+      if (l != "newton" && l != "semi") {
+        std::fprintf(stderr, "--lin newton|semi\n");
+        return 2;
+      }
+      s.lin = l == "newton" ? Linearisation::newton : Linearisation::semi_implicit;
+    } else if (a == "--csv") csv = next();
+    else if (a == "--energy-bound") s.energy_bound = std::atof(next().c_str());
+    else if (a == "--max-drift") s.max_drift = std::atof(next().c_str());
+    else if (a == "--trace") s.trace_dt = std::atof(next().c_str());
+    else if (a == "--mesh-motion") {
+      const std::string m = next();
+      if (m != "shear" && m != "rigid") {
+        std::fprintf(stderr, "--mesh-motion shear|rigid\n");
+        return 2;
+      }
+      s.rigid = m == "rigid";
+    }
+    else {
+      std::fprintf(stderr,
+                   "usage: %s [--schemes MR_AB,BDF2_BDF2E,BDF2_AB,BDF3_BDF3E,BSS] [--h H] [--mu M1,M2] [--T T]\n"
+                   "          [--min-steps N] [--dt-lo DT] [--dt-hi DT] [--tol REL] [--lin newton|semi] [--csv FILE]\n"
+                   "          [--mesh-motion shear|rigid] [--max-drift D] [--energy-bound F]\n"
+                   "          [--trace DT]\n",
+                   argv[0]);
+      return 2;
+    }
+  }
+  if (!(s.h > 0) || !(s.dt_lo > 0) || !(s.dt_hi > s.dt_lo) || !(s.tol > 0) || mus.empty()) {
+    std::fprintf(stderr, "invalid settings\n");
+    return 2;
+  }
+  std::vector<const SchemeEntry*> chosen;
+  for (const auto& k : schemes) {
+    auto it = std::find_if(all_schemes.begin(), all_schemes.end(), [&](const SchemeEntry& e) { return k == e.key; });
+    if (it == all_schemes.end()) {
+      std::fprintf(stderr, "unknown scheme %s\n", k.c_str());
+      return 2;
+    }
+    chosen.push_back(&*it);
+  }
+  try {
+    const auto tm = Clock::now();
+    const Mesh<2> mesh = annulus_unstructured(R1, R2, s.h);
+    std::printf("annulus R1=%g R2=%g, h=%g: %ld nodes, %ld triangles, %ld DOFs (P1/P1-GLS), meshed in %.2f s\n", R1, R2,
+                s.h, long(mesh.n_nodes()), long(mesh.n_cells()), long(3 * mesh.n_nodes()),
+                std::chrono::duration<double>(Clock::now() - tm).count());
+    std::printf("omega=%g, rho=%g, %s, mesh motion %s, run to max(T=%g, %d steps), start-up %d steps, max drift %g, "
+                "bisection tol %g%%\n",
+                omega, rho, s.lin == Linearisation::newton ? "Newton" : "semi-implicit", s.rigid ? "rigid" : "shear", s.T,
+                s.min_steps, s.startup_steps, s.max_drift < 0 ? s.h : s.max_drift, 100 * s.tol);
+    if (s.trace_dt > 0) {
+      for (Real mu : mus)
+        for (const auto* e : chosen) {
+          std::printf("%s, mu = %g, dt = %g:\n", e->key, mu, s.trace_dt);
+          print_probe(e->probe(mesh, mu, s.trace_dt, s, true));
+        }
+      return 0;
+    }
+    std::vector<Result> results;
+    for (Real mu : mus)
+      for (const auto* e : chosen) results.push_back(e->bisect(mesh, mu, s));
+    std::printf("\n| scheme | mu | largest stable dt | first unstable dt (reason, at t) | wall drift at dt_max | probes | time (s) |\n");
+    std::printf("|---|---|---|---|---|---|---|\n");
+    for (const auto& r : results) {
+      char fu[160] = "-";
+      if (r.first_unstable.dt > 0)
+        std::snprintf(fu, sizeof fu, "%.4f (%s, t = %.3f)", r.first_unstable.dt, outcome_name(r.first_unstable.outcome),
+                      r.first_unstable.t);
+      char dr[32] = "-";
+      if (r.last_stable.dt > 0) std::snprintf(dr, sizeof dr, "%.1e", r.last_stable.drift);
+      std::printf("| %s | %g | %s | %s | %s | %d | %.0f |\n", r.scheme.c_str(), r.mu, r.dt_max.c_str(), fu, dr, r.probes,
+                  r.wall);
+    }
+    if (!csv.empty()) {
+      std::ofstream f(csv);
+      f << "scheme,mu,h,linearisation,dt_max,bracket_lo,bracket_hi,first_unstable_reason,first_unstable_t,"
+           "drift_at_dt_max,probes,wall_s\n";
+      for (const auto& r : results)
+        f << r.scheme << ',' << r.mu << ',' << s.h << ',' << (s.lin == Linearisation::newton ? "Newton" : "semi-implicit")
+          << ',' << r.dt_max << ',' << r.lo << ',' << r.hi << ','
+          << (r.first_unstable.dt > 0 ? outcome_name(r.first_unstable.outcome) : "") << ',' << r.first_unstable.t << ','
+          << r.last_stable.drift << ',' << r.probes << ',' << r.wall << '\n';
+      std::printf("wrote %s\n", csv.c_str());
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -22,6 +22,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <utility>
 #include <vector>
 
 #include "alefsi/core/error.hpp"
@@ -158,6 +159,35 @@ void shift_pressure_to_zero_mean(const MixedSpace<D, Pair>& space, VecX& field) 
   for (Index k = 0; k < space.pressure().n_dofs(); ++k) field[space.pressure_field(k)] -= mean;
 }
 
+/// Fixes every velocity component on the boundary facets of each tag in `tags` (a map or set
+/// keyed by tag), to 0: set the values with `DofConstraints::set_fixed_value`. DOFs already
+/// marked in `taken` (size n_u) are skipped and the fixed ones are marked. Returns the
+/// (scalar velocity DOF, tag) pairs, the first tag winning where tags meet.
+template <int D, ElementPair Pair, class Tags>
+std::vector<std::pair<Index, int>> fix_velocity_on_tags(const MixedSpace<D, Pair>& space, const Tags& tags,
+                                                        DofConstraints& cons, std::vector<char>& taken) {
+  std::vector<std::pair<Index, int>> fixed;
+  for (const auto& entry : tags) {
+    const int tag = entry.first;
+    for (Index i : space.velocity().boundary_dofs(tag)) {
+      if (taken[i]) continue;
+      taken[i] = 1;
+      fixed.emplace_back(i, tag);
+      for (int k = 0; k < D; ++k) cons.fix(space.velocity_field(i, k), 0.0);
+    }
+  }
+  return fixed;
+}
+
+/// True when every boundary facet's tag satisfies `prescribed(tag)`: the velocity is then given
+/// on the whole boundary and the pressure is defined up to a constant only.
+template <int D, class Pred>
+bool whole_boundary_prescribed(const Mesh<D>& mesh, Pred&& prescribed) {
+  for (Index f : mesh.boundary_facets())
+    if (!prescribed(mesh.facet_tag(f))) return false;
+  return true;
+}
+
 /// A steady Stokes problem on a fixed mesh: Dirichlet conditions by boundary tag, then solve.
 template <int D, ElementPair Pair>
 class Stokes {
@@ -185,16 +215,12 @@ class Stokes {
   VecX solve(Solver solver = Solver{}) {
     DofConstraints cons(space_.n_field());
     const auto& vel = space_.velocity();
-    std::vector<char> done(vel.n_dofs(), 0);
-    for (const auto& [tag, g] : dirichlet_)
-      for (Index i : vel.boundary_dofs(tag)) {
-        if (done[i]) continue;
-        done[i] = 1;
-        const Vec<D> val = g(vel.point(i));
-        for (int k = 0; k < D; ++k) cons.fix(space_.velocity_field(i, k), val[k]);
-      }
-    pinned_ = true;
-    for (Index f : space_.mesh().boundary_facets()) pinned_ &= dirichlet_.count(space_.mesh().facet_tag(f)) > 0;
+    std::vector<char> taken(vel.n_dofs(), 0);
+    for (const auto& [i, tag] : fix_velocity_on_tags(space_, dirichlet_, cons, taken)) {
+      const Vec<D> val = dirichlet_.at(tag)(vel.point(i));
+      for (int k = 0; k < D; ++k) cons.set_fixed_value(space_.velocity_field(i, k), val[k]);
+    }
+    pinned_ = whole_boundary_prescribed(space_.mesh(), [&](int tag) { return dirichlet_.count(tag) > 0; });
     if (pinned_) cons.fix(space_.pressure_field(0), 0.0);
     cons.finalize();
     Assembler<Space::n_local> asmb(space_.mesh().n_cells(), [&](Index c) { return space_.cell_field_dofs(c); }, cons);

@@ -162,13 +162,7 @@ class AleFlow {
     cons_ = std::make_unique<DofConstraints>(space_.n_field());
     const auto& vel = space_.velocity();
     std::vector<char> done(vel.n_dofs(), 0);
-    for (const auto& [tag, g] : dirichlet_)
-      for (Index i : vel.boundary_dofs(tag)) {
-        if (done[i]) continue;
-        done[i] = 1;
-        dirichlet_dofs_.push_back({i, tag});
-        for (int k = 0; k < D; ++k) cons_->fix(space_.velocity_field(i, k), 0.0);
-      }
+    dirichlet_dofs_ = fix_velocity_on_tags(space_, dirichlet_, *cons_, done);
     if constexpr (D == 2)
       for (auto& b : bodies_) {
         if (b.data.free()) b.extra = cons_->add_unknowns(3);
@@ -188,12 +182,12 @@ class AleFlow {
           }
         }
       }
-    pinned_ = true;  // every boundary velocity prescribed (walls or bodies): p up to a constant
-    for (Index f : mesh_.boundary_facets()) {
+    // every boundary velocity prescribed (walls or bodies): p is defined up to a constant
+    pinned_ = whole_boundary_prescribed(mesh_, [&](int tag) {
       bool body = false;
-      for (const auto& b : bodies_) body |= b.data.tag == mesh_.facet_tag(f);
-      pinned_ &= body || dirichlet_.count(mesh_.facet_tag(f)) > 0;
-    }
+      for (const auto& b : bodies_) body |= b.data.tag == tag;
+      return body || dirichlet_.count(tag) > 0;
+    });
     if (pinned_) cons_->fix(space_.pressure_field(0), 0.0);
     cons_->finalize();
     asmb_ = std::make_unique<Assembler<Space::n_local>>(

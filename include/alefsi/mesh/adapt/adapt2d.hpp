@@ -638,16 +638,7 @@ inline Mesh<2> adapt(const Mesh<2>& moved, const std::vector<BoundaryCurve>& cur
       if (k == 0) break;
     }
     const int c = M.collapse_pass(rep.refused);
-    rep.flips += M.flip_all();
-    for (int sweep = 0; sweep < options.smoothing_sweeps; ++sweep) {
-      const int k = M.smooth_sweep();
-      rep.smoothed += k;
-      if (k == 0) break;
-    }
-    rep.flips += M.flip_all();
-    int rs = 0, rc = 0;
-    M.repair_pass(rs, rc);
-    if (rs + rc > 0) {
+    auto flip_smooth_flip = [&] {
       rep.flips += M.flip_all();
       for (int sweep = 0; sweep < options.smoothing_sweeps; ++sweep) {
         const int k = M.smooth_sweep();
@@ -655,7 +646,11 @@ inline Mesh<2> adapt(const Mesh<2>& moved, const std::vector<BoundaryCurve>& cur
         if (k == 0) break;
       }
       rep.flips += M.flip_all();
-    }
+    };
+    flip_smooth_flip();
+    int rs = 0, rc = 0;
+    M.repair_pass(rs, rc);
+    if (rs + rc > 0) flip_smooth_flip();
     rep.splits += s + rs, rep.collapses += c + rc;
     if (s + c == 0) break;
   }

@@ -10,6 +10,7 @@
 #include "alefsi/fem/dofmap.hpp"
 #include "alefsi/la/assembler.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
+#include "alefsi/physics/stokes.hpp"
 
 using namespace alefsi;
 
@@ -24,6 +25,24 @@ struct PseudoRandomKernel {  // deterministic, cell-dependent, non-symmetric
     r += A * u;
   }
 };
+
+// The unit square / cube with every node moved by a smooth, non-affine map (cells stay
+// valid and become non-similar): no two cells share a Jacobian.
+template <int D>
+Mesh<D> distorted_mesh(int n) {
+  Mesh<D> mesh = [&] {
+    if constexpr (D == 2) return rectangle_mesh(n, n);
+    else return box_mesh(n, n, n);
+  }();
+  std::vector<Vec<D>> x = mesh.coordinates();
+  for (auto& p : x) {
+    Vec<D> s = p;
+    for (int i = 0; i < D; ++i) s[i] += 0.08 * std::sin(3.1 * p[(i + 1) % D] + 0.7 * i) * std::sin(2.3 * p[i]);
+    p = 1.7 * s;  // and not the unit size
+  }
+  mesh.set_coordinates(std::move(x));
+  return mesh;
+}
 }  // namespace
 
 TEST_CASE("DofMap numbers vertices then edges; MixedSpace interleaves velocity", "[fem][dofs][quick]") {
@@ -138,4 +157,57 @@ TEMPLATE_TEST_CASE("assembly equals the dense T^T A T for free, fixed and linked
   SparseMatrix J2 = J;
   asmb.assemble(k, field, &J2, nullptr);
   CHECK((MatX(J2) - Jd).norm() == 0.0);
+}
+
+TEMPLATE_TEST_CASE("Stokes kernel from reference integrals equals the quadrature kernel", "[la][assembly][stokes][quick]",
+                   TaylorHood, P1P1Gls) {
+  auto check = [](auto dim_tag) {
+    constexpr int D = decltype(dim_tag)::value;
+    const auto mesh = distorted_mesh<D>(D == 2 ? 5 : 2);
+    using Space = MixedSpace<D, TestType>;
+    Space space(mesh);
+    auto force = [](const Vec<D>& x) {
+      Vec<D> f;
+      for (int i = 0; i < D; ++i) f[i] = std::cos(1.3 * x[i] + i) * std::exp(0.4 * x[(i + 1) % D]);
+      return f;
+    };
+    const Real mu = 0.37;
+    const StokesKernel<D, TestType> fast(space, mu, force);
+    const StokesQuadratureKernel<D, TestType> ref(space, mu, force);
+    using LocalVec = Eigen::Matrix<Real, Space::n_local, 1>;
+    using LocalMat = Eigen::Matrix<Real, Space::n_local, Space::n_local>;
+    Real worst_A = 0, worst_r = 0;
+    for (Index c = 0; c < mesh.n_cells(); ++c) {
+      LocalVec u;
+      for (int i = 0; i < Space::n_local; ++i) u[i] = std::sin(0.9 * c + 1.1 * i);
+      LocalMat A1, A2;
+      LocalVec r1, r2;
+      fast.cell(c, u, A1, r1);
+      ref.cell(c, u, A2, r2);
+      worst_A = std::max(worst_A, (A1 - A2).norm() / A2.norm());
+      worst_r = std::max(worst_r, (r1 - r2).norm() / r2.norm());
+      CHECK((A1 - A1.transpose()).norm() <= 1e-14 * A1.norm());
+    }
+    INFO("D = " << D << ", worst relative differences: A " << worst_A << ", r " << worst_r);
+    CHECK(worst_A <= 1e-12);
+    CHECK(worst_r <= 1e-12);
+    // and the assembled systems
+    DofConstraints cons(space.n_field());
+    for (Index i : space.velocity().boundary_dofs(1))
+      for (int k = 0; k < D; ++k) cons.fix(space.velocity_field(i, k), 0.3 * k + 0.1);
+    cons.finalize();
+    Assembler<Space::n_local> asmb(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
+    VecX field(space.n_field());
+    for (Index f = 0; f < field.size(); ++f) field[f] = std::cos(0.3 * f);
+    field = cons.expand(cons.restrict_free(field));
+    SparseMatrix J1, J2;
+    VecX s1, s2;
+    asmb.assemble(fast, field, &J1, &s1);
+    asmb.assemble(ref, field, &J2, &s2);
+    const MatX d = MatX(J1) - MatX(J2);
+    CHECK(d.norm() <= 1e-12 * MatX(J2).norm());
+    CHECK((s1 - s2).norm() <= 1e-12 * s2.norm());
+  };
+  check(std::integral_constant<int, 2>{});
+  check(std::integral_constant<int, 3>{});
 }

@@ -31,6 +31,7 @@
 #include "alefsi/fem/quadrature.hpp"
 #include "alefsi/la/assembler.hpp"
 #include "alefsi/la/solvers.hpp"
+#include "alefsi/physics/affine_forms.hpp"
 
 namespace alefsi {
 
@@ -58,8 +59,86 @@ struct ReferenceTables {
   std::vector<typename P::Gradients> dphi_p;
 };
 
+/// The Stokes element kernel (affine cells): A from precomputed reference integrals
+/// (`AffineStokesForms`: viscous, divergence and, for P1/P1-GLS, PSPG pressure blocks), no
+/// quadrature loop; the body-force load (if any) by quadrature of degree 2k + 2 as in
+/// `StokesQuadratureKernel`, which this kernel equals to round-off. r = A u - F.
+/// `cell` is const and touches only its arguments: safe to call from several threads (the
+/// force function must then be too).
 template <int D, ElementPair Pair>
 class StokesKernel {
+ public:
+  using Space = MixedSpace<D, Pair>;
+  using V = typename Space::VelocityElement;
+  using P = typename Space::PressureElement;
+  using Forms = AffineStokesForms<D, Pair>;
+  static constexpr int nv = V::n_dofs, np = P::n_dofs, n_local = Space::n_local;
+  using LocalVec = Eigen::Matrix<Real, n_local, 1>;
+  using LocalMat = Eigen::Matrix<Real, n_local, n_local>;
+
+  /// `force` may be empty (no body force).
+  StokesKernel(const Space& space, Real mu, VectorFunction<D> force = {}, Real c1 = 4.0)
+      : space_(&space), mu_(mu), c1_(c1), f_(std::move(force)), forms_(&Forms::get()), tab_(2 * V::degree + 2) {
+    ALEFSI_CHECK_ARG(mu > 0 && std::isfinite(mu), "mu", "viscosity must be positive and finite, got ", mu);
+    ALEFSI_CHECK_ARG(c1 > 0, "c1", "GLS constant must be positive");
+  }
+
+  /// GLS/PSPG parameter of cell c (0 for stable pairs).
+  Real tau(Index c) const {
+    if constexpr (!Pair::stabilised) return 0;
+    const Real h = space_->mesh().diameter(c);
+    return h * h / (c1_ * mu_);
+  }
+
+  void cell(Index c, const LocalVec& u, LocalMat& A, LocalVec& r) const {
+    const Mat<D> J = space_->mesh().jacobian(c);
+    const Mat<D> Jinv = J.inverse();
+    const Real detJ = J.determinant();
+    A.setZero();
+    forms_->add_viscous(Jinv, detJ, mu_, A);
+    forms_->add_divergence(Jinv, detJ, -1.0, -1.0, A);
+    Real tau_c = 0;
+    if constexpr (Pair::stabilised) {
+      tau_c = tau(c);
+      forms_->add_pressure_laplacian(Jinv, detJ, -tau_c, A);
+    }
+    r.noalias() = A * u;
+    if (f_) r -= load(c, J, Jinv, detJ, tau_c);
+  }
+
+  /// The load vector F of cell c (body force; PSPG part for stabilised pairs).
+  LocalVec load(Index c, const Mat<D>& J, const Mat<D>& Jinv, Real detJ, Real tau_c) const {
+    LocalVec F = LocalVec::Zero();
+    const auto& mesh = space_->mesh();
+    const Vec<D> x0 = mesh.node(mesh.cell(c)[0]);
+    const auto& rule = *tab_.rule;
+    for (int q = 0; q < rule.size(); ++q) {
+      const Real w = rule.weights[q] * detJ;
+      const Vec<D> fq = f_(x0 + J * rule.points[q]);
+      const auto& phv = tab_.phi_v[q];
+      for (int a = 0; a < nv; ++a)
+        for (int i = 0; i < D; ++i) F[D * a + i] += w * fq[i] * phv[a];
+      if constexpr (Pair::stabilised) {
+        const Eigen::Matrix<Real, np, D> Gp = tab_.dphi_p[q] * Jinv;
+        for (int a = 0; a < np; ++a) F[D * nv + a] -= w * tau_c * fq.dot(Gp.row(a));
+      }
+    }
+    return F;
+  }
+
+ private:
+  const Space* space_;
+  Real mu_, c1_;
+  VectorFunction<D> f_;
+  const Forms* forms_;
+  ReferenceTables<D, Pair> tab_;
+};
+
+/// The Stokes element kernel by quadrature (degree 2k + 2, every term at every point): the
+/// reference implementation `StokesKernel` is tested against (same interface, same results to
+/// round-off, 5-10x slower).
+template <int D, ElementPair Pair>
+class StokesQuadratureKernel {
  public:
   using Space = MixedSpace<D, Pair>;
   using V = typename Space::VelocityElement;
@@ -69,7 +148,7 @@ class StokesKernel {
   using LocalMat = Eigen::Matrix<Real, n_local, n_local>;
 
   /// `force` may be empty (no body force).
-  StokesKernel(const Space& space, Real mu, VectorFunction<D> force = {}, Real c1 = 4.0)
+  StokesQuadratureKernel(const Space& space, Real mu, VectorFunction<D> force = {}, Real c1 = 4.0)
       : space_(&space), mu_(mu), c1_(c1), f_(std::move(force)), tab_(2 * V::degree + 2) {
     ALEFSI_CHECK_ARG(mu > 0 && std::isfinite(mu), "mu", "viscosity must be positive and finite, got ", mu);
     ALEFSI_CHECK_ARG(c1 > 0, "c1", "GLS constant must be positive");

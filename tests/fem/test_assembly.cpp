@@ -211,3 +211,63 @@ TEMPLATE_TEST_CASE("Stokes kernel from reference integrals equals the quadrature
   check(std::integral_constant<int, 2>{});
   check(std::integral_constant<int, 3>{});
 }
+
+TEST_CASE("threaded assembly is bit-identical to one thread; a throwing kernel is reported", "[la][assembly][threads][quick]") {
+  const auto mesh = annulus_mesh(0.3, 1.0, 14, 96);  // 2688 cells: several chunks and colours
+  using Space = MixedSpace<2, TaylorHood>;
+  Space space(mesh);
+  DofConstraints cons(space.n_field());
+  const Index z = cons.add_unknowns(3);
+  for (Index i : space.velocity().boundary_dofs(tags::outer))
+    for (int k = 0; k < 2; ++k) cons.fix(space.velocity_field(i, k), 0.1 * (k + 1));
+  for (Index i : space.velocity().boundary_dofs(tags::inner)) {
+    const Vec<2> x = space.velocity().point(i);
+    const Index ex[] = {z, z + 1, z + 2};
+    const Real w0[] = {1.0, 0.0, -x[1]}, w1[] = {0.0, 1.0, x[0]};
+    cons.link(space.velocity_field(i, 0), ex, w0, 0.01);
+    cons.link(space.velocity_field(i, 1), ex, w1, -0.02);
+  }
+  cons.finalize();
+  Assembler<Space::n_local> asmb(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
+  REQUIRE(asmb.n_colours() >= 2);
+  VecX field(space.n_field());
+  for (Index f = 0; f < field.size(); ++f) field[f] = std::sin(1.7 * f);
+  PseudoRandomKernel<Space::n_local> k;
+  SparseMatrix J1, Jt;
+  VecX r1, rt;
+  asmb.assemble(k, field, &J1, &r1);
+  // a plain loop over the cells in cell order agrees to round-off
+  SparseMatrix Jp = asmb.matrix();
+  std::fill(Jp.valuePtr(), Jp.valuePtr() + Jp.nonZeros(), 0.0);
+  VecX rp = VecX::Zero(asmb.n_unknowns());
+  for (Index c = 0; c < mesh.n_cells(); ++c) {
+    typename Assembler<Space::n_local>::LocalMat A;
+    typename Assembler<Space::n_local>::LocalVec re;
+    k.cell(c, asmb.gather(c, field), A, re);
+    asmb.scatter(c, A, re, Jp.valuePtr(), &rp);
+  }
+  CHECK((MatX(Jp) - MatX(J1)).norm() <= 1e-13 * MatX(J1).norm());
+  CHECK((rp - r1).norm() <= 1e-13 * r1.norm());
+  for (int t : {2, 3, 5}) {
+    asmb.set_threads(t);
+    asmb.assemble(k, field, &Jt, &rt);
+    INFO("threads = " << t);
+    REQUIRE(Jt.nonZeros() == J1.nonZeros());
+    CHECK(std::equal(Jt.valuePtr(), Jt.valuePtr() + Jt.nonZeros(), J1.valuePtr()));
+    CHECK(std::equal(rt.data(), rt.data() + rt.size(), r1.data()));
+  }
+  // a kernel that throws on some cell: the exception reaches the caller, no thread hangs
+  struct Throwing {
+    void cell(Index c, const Eigen::Matrix<Real, Space::n_local, 1>&, Eigen::Matrix<Real, Space::n_local, Space::n_local>& A,
+              Eigen::Matrix<Real, Space::n_local, 1>& r) const {
+      if (c == 1000) throw SolverError("bad cell");
+      A.setZero();
+      r.setZero();
+    }
+  };
+  for (int t : {1, 2}) {
+    asmb.set_threads(t);
+    CHECK_THROWS_AS(asmb.assemble(Throwing{}, field, &Jt, &rt), SolverError);
+  }
+  CHECK_THROWS_AS(asmb.set_threads(0), InvalidArgument);
+}

@@ -1,30 +1,53 @@
 #pragma once
 /// \file la/assembler.hpp
 /// In-house sparse assembly: the pattern is built once per mesh topology, element matrices
-/// scatter through precomputed positions.
+/// scatter through precomputed positions, optionally on several threads.
 ///
 /// The global matrix is an Eigen column-major `SparseMatrix` (what SparseLU factorises) whose
 /// structure is filled once, by the constructor, from the cells' field DOFs and the
-/// `DofConstraints` (a cell couples every unknown its field DOFs depend on). For every cell the
-/// constructor stores, for each pair of local unknowns, the offset of that entry in the value
-/// array, so assembly does no search, no sorting and no allocation.
+/// `DofConstraints` (a cell couples every unknown its field DOFs depend on).
+///
+/// Blocks. A cell's local unknowns are grouped into *blocks*: runs of local DOFs whose unknowns
+/// are consecutive and whose columns have the same rows (the free components of one velocity
+/// node, interleaved in the field vector; a rigid body's d(d+1)/2 unknowns). Rows of a block
+/// are contiguous in every column, and the columns of a block are equally long, so one stored
+/// position per (row block, column block) pair addresses the whole D x D sub-matrix: D^2 fewer
+/// positions than one per DOF pair (2D P2/P1: 81 instead of 225 per cell), and the pattern
+/// build works per node instead of per unknown. Assembly does no search, no sort and no
+/// allocation.
 ///
 /// Cells whose field DOFs are each free or fixed ("simple" cells: the vast majority) scatter the
 /// element matrix directly, skipping fixed rows/columns. Cells with a linked DOF (a rigid body's
 /// surface) first form T_e^T A_e T_e on their distinct unknowns, with the link weights current at
 /// assembly time.
 ///
+/// Threads. `set_threads(t)` (default 1) assembles on t std::threads. The simple cells are cut
+/// into chunks of `chunk_size` consecutive cells, and the chunks are coloured so that two chunks
+/// of one colour share no unknown: chunks of a colour run concurrently, colours one after the
+/// other, each chunk in cell order; then the linked cells, in cell order, on one thread. Every
+/// matrix/residual entry therefore receives its contributions in the same order whatever the
+/// thread count: results are bit-identical for any t (and equal to round-off to a plain loop
+/// over the cells). The kernel's `cell` is then called concurrently and must be safe to call so.
+///
 /// The kernel is called as `kernel.cell(c, u_e, A_e, r_e)` with the cell's local field values
 /// u_e (constraint offsets included) and must fill the local Jacobian A_e and residual r_e,
 /// both of the compile-time size `N` (the space's local field DOFs).
 ///
 ///     Assembler<Space::n_local> asmb(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
+///     asmb.set_threads(2);                    // optional
 ///     asmb.assemble(kernel, field, &J, &r);   // J: asmb.matrix() shape, r: n_unknowns
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <barrier>
+#include <bit>
 #include <concepts>
 #include <cstdint>
+#include <exception>
+#include <mutex>
 #include <numeric>
+#include <string>
+#include <thread>
 #include <vector>
 
 #include "alefsi/core/eigen_sparse.hpp"
@@ -46,6 +69,9 @@ template <int N>
 class Assembler {
  public:
   static constexpr int n_local = N;
+  /// Cells per chunk of the thread schedule (fixed: the schedule, hence the summation order,
+  /// must not depend on the thread count).
+  static constexpr Index chunk_size = 256;
   using LocalVec = Eigen::Matrix<Real, N, 1>;
   using LocalMat = Eigen::Matrix<Real, N, N>;
   using CellDofs = std::array<Index, N>;
@@ -58,6 +84,7 @@ class Assembler {
     for (Index c = 0; c < n_cells; ++c) dofs_[c] = cell_dofs(c);
     build_local_unknowns();
     build_pattern();
+    build_schedule();
   }
 
   Index n_unknowns() const { return cons_->n_unknowns(); }
@@ -68,6 +95,17 @@ class Assembler {
   SparseMatrix& matrix() { return matrix_; }
   /// Number of cells that touch a linked DOF.
   Index n_linked_cells() const { return n_general_; }
+  /// Number of colours of the chunk schedule (see the file comment).
+  Index n_colours() const { return Index(colour_start_.size()) - 1; }
+  /// Number of stored scatter positions (one per block pair per cell).
+  std::size_t n_positions() const { return pos_.size(); }
+
+  /// Threads used by `assemble` (>= 1; default 1). Results do not depend on it.
+  void set_threads(int t) {
+    ALEFSI_CHECK_ARG(t >= 1, "threads", "must be at least 1, got ", t);
+    threads_ = t;
+  }
+  int threads() const { return threads_; }
 
   /// Gathers cell c's local field values.
   LocalVec gather(Index c, const VecX& field) const {
@@ -83,34 +121,86 @@ class Assembler {
   void assemble(const Kernel& kernel, const VecX& field, SparseMatrix* J, VecX* r) const {
     ALEFSI_CHECK_ARG(field.size() == cons_->n_field(), "field", "has ", field.size(), " entries, expected ",
                      cons_->n_field());
-    if (J) {
-      if (J->rows() != matrix_.rows() || J->nonZeros() != matrix_.nonZeros()) *J = matrix_;
-      std::fill(J->valuePtr(), J->valuePtr() + J->nonZeros(), Real(0));
-    }
-    if (r) r->setZero(n_unknowns());
+    if (J && (J->rows() != matrix_.rows() || J->nonZeros() != matrix_.nonZeros())) *J = matrix_;
+    if (r) r->resize(n_unknowns());
     Real* val = J ? J->valuePtr() : nullptr;
-    LocalMat A;
-    LocalVec re;
-    for (Index c = 0; c < n_cells(); ++c) {
-      const LocalVec u = gather(c, field);
-      kernel.cell(c, u, A, re);
-      scatter(c, A, re, val, r);
+    const std::size_t nnz = J ? std::size_t(J->nonZeros()) : 0;
+    const int nt = int(std::min<Index>(threads_, std::max<Index>(1, Index(chunk_cells_.size()))));
+    // worker t: zero its slice of J and r, then the colours; the linked cells on thread 0
+    auto work = [&](int t, auto&& sync) {
+      if (val) std::fill(val + nnz * t / nt, val + nnz * (t + 1) / nt, Real(0));
+      if (r) {
+        const Index nu = n_unknowns();
+        std::fill(r->data() + std::size_t(nu) * t / nt, r->data() + std::size_t(nu) * (t + 1) / nt, Real(0));
+      }
+      sync();
+      LocalMat A;
+      LocalVec re;
+      for (Index col = 0; col < n_colours(); ++col) {
+        const Index b = colour_start_[col], e = colour_start_[col + 1];
+        // chunks of one colour, dealt round-robin (static: no shared counter to contend on)
+        for (Index k = b + t; k < e; k += nt) {
+          const Index ch = chunk_order_[k];
+          for (Index i = chunk_start_[ch]; i < chunk_start_[ch + 1]; ++i) {
+            const Index c = chunk_cells_[i];
+            kernel.cell(c, gather(c, field), A, re);
+            scatter(c, A, re, val, r);
+          }
+        }
+        sync();
+      }
+      if (t == 0)
+        for (Index c : linked_cells_) {
+          kernel.cell(c, gather(c, field), A, re);
+          scatter(c, A, re, val, r);
+        }
+    };
+    if (nt == 1) {
+      work(0, [] {});
+      return;
     }
+    std::barrier sync_point(nt);
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    std::atomic<bool> failed{false};
+    // a throwing kernel must not leave the other threads waiting at a barrier: the failing
+    // thread records the exception and keeps arriving at the barriers without working
+    auto guarded = [&](int t) {
+      bool ok = true;
+      auto sync = [&] {
+        sync_point.arrive_and_wait();
+        if (failed.load()) throw Aborted{};
+      };
+      try {
+        work(t, sync);
+      } catch (const Aborted&) {
+        ok = false;
+      } catch (...) {
+        {
+          std::lock_guard<std::mutex> lock(error_mutex);
+          if (!error) error = std::current_exception();
+        }
+        failed.store(true);
+        ok = false;
+      }
+      if (!ok) {  // finish this thread's share of barrier phases: 1 (zeroing) + n_colours
+        // phases already passed are not known here; arrive_and_drop removes this thread from
+        // every later phase instead
+        sync_point.arrive_and_drop();
+      }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < nt; ++t) pool.emplace_back(guarded, t);
+    guarded(0);
+    for (auto& th : pool) th.join();
+    if (error) std::rethrow_exception(error);
   }
 
   /// Scatters one element's Jacobian/residual (exposed for benchmarks and custom loops).
   void scatter(Index c, const LocalMat& A, const LocalVec& re, Real* val, VecX* r) const {
     const Index* red = &red_[red_start_[c]];
-    const Index* pos = &pos_[pos_start_[c]];
     if (!general_[c]) {
-      if (val)
-        for (int i = 0; i < N; ++i) {
-          if (red[i] < 0) continue;
-          for (int j = 0; j < N; ++j) {
-            const Index p = pos[i * N + j];
-            if (p >= 0) val[p] += A(i, j);
-          }
-        }
+      if (val) scatter_blocks(c, A.data(), N, val);
       if (r)
         for (int i = 0; i < N; ++i)
           if (red[i] >= 0) (*r)[red[i]] += re[i];
@@ -136,14 +226,38 @@ class Assembler {
         }
       }
     }
-    if (val)
-      for (Index i = 0; i < m; ++i)
-        for (Index j = 0; j < m; ++j) val[pos[i * m + j]] += Ar(i, j);
+    if (val) scatter_blocks(c, Ar.data(), m, val);
     if (r)
       for (Index i = 0; i < m; ++i) (*r)[red[i]] += rr[i];
   }
 
  private:
+  struct Aborted {};
+  /// A run of local unknowns [start, start + size) of one cell; `stride`: the length of each
+  /// of its columns in the CSR/CSC storage (consecutive columns of a block are that far apart).
+  struct Block {
+    std::int16_t start, size;
+    Index stride;
+  };
+
+  // Adds the column-major local matrix A (leading dimension lda, the cell's local unknown
+  // order) through the block positions.
+  void scatter_blocks(Index c, const Real* A, Index lda, Real* val) const {
+    const Block* blk = &blk_[blk_start_[c]];
+    const Index nb = blk_start_[c + 1] - blk_start_[c];
+    const Index* pos = &pos_[pos_start_[c]];
+    for (Index J = 0; J < nb; ++J) {
+      const Block bj = blk[J];
+      for (Index I = 0; I < nb; ++I, ++pos) {
+        const Block bi = blk[I];
+        const Real* a = A + std::ptrdiff_t(bj.start) * lda + bi.start;
+        Real* v = val + *pos;
+        for (int t = 0; t < bj.size; ++t, a += lda, v += bj.stride)
+          for (int s = 0; s < bi.size; ++s) v[s] += a[s];
+      }
+    }
+  }
+
   // Per cell: its reduced unknown list. Simple cells: N entries (unknown or -1 for fixed).
   // Linked cells: the distinct unknowns, plus for each local DOF entry its reduced index.
   void build_local_unknowns() {
@@ -151,6 +265,7 @@ class Assembler {
     general_.assign(nc, 0);
     red_start_.assign(nc + 1, 0);
     ent_start_.assign(nc + 1, 0);
+    red_.reserve(std::size_t(nc) * N);
     for (Index c = 0; c < nc; ++c) {
       bool gen = false;
       for (Index f : dofs_[c]) gen |= cons_->kind(f) == DofConstraints::Kind::linked;
@@ -174,58 +289,93 @@ class Assembler {
     }
   }
 
-  // Column-by-column pattern build: for unknown u, the rows are the unknowns of the cells that
-  // touch u. A marker array makes it linear in the number of (cell, local pair) couplings.
+  // Pattern build, one column *group* at a time: a group is a run of consecutive unknowns
+  // touched by exactly the same cells (the free components of one node), so its columns have
+  // the same rows. The rows of a group (union of its cells' unknowns, found with a marker
+  // array, then sorted) are computed once, and each cell touching the group gets the position
+  // of each of its (row block, column block) pairs whose column block starts in the group.
   void build_pattern() {
     const Index n = n_unknowns(), nc = n_cells();
-    // unknown -> (cell, reduced local index) lists
+    // unknown -> cells touching it (in cell order)
     std::vector<Index> ustart(n + 1, 0);
-    for (Index c = 0; c < nc; ++c)
-      for (Index k = red_start_[c]; k < red_start_[c + 1]; ++k)
-        if (red_[k] >= 0) ++ustart[red_[k] + 1];
+    for (Index k = 0; k < red_start_[nc]; ++k)
+      if (red_[k] >= 0) ++ustart[red_[k] + 1];
     std::partial_sum(ustart.begin(), ustart.end(), ustart.begin());
-    std::vector<Index> ucell(ustart[n]), uloc(ustart[n]), fill(ustart.begin(), ustart.end() - 1);
-    for (Index c = 0; c < nc; ++c)
-      for (Index k = red_start_[c]; k < red_start_[c + 1]; ++k)
-        if (red_[k] >= 0) {
-          ucell[fill[red_[k]]] = c;
-          uloc[fill[red_[k]]++] = k - red_start_[c];
-        }
-    pos_start_.assign(nc + 1, 0);
-    for (Index c = 0; c < nc; ++c) {
-      const std::size_t m = std::size_t(red_start_[c + 1] - red_start_[c]);
-      pos_start_[c + 1] = pos_start_[c] + std::int64_t(m * m);
+    std::vector<Index> ucell(ustart[n]);
+    {
+      std::vector<Index> fill(ustart.begin(), ustart.end() - 1);
+      for (Index c = 0; c < nc; ++c)
+        for (Index k = red_start_[c]; k < red_start_[c + 1]; ++k)
+          if (red_[k] >= 0) ucell[fill[red_[k]]++] = c;
     }
-    pos_.assign(pos_start_[nc], -1);
-    std::vector<Index> outer(n + 1, 0), inner, where(n, -1), rows;
+    for (Index u = 0; u < n; ++u)
+      if (ustart[u + 1] == ustart[u]) throw SolverError("unknown " + std::to_string(u) + " is coupled to nothing");
+    // same_prev[u]: u continues the group of u - 1
+    std::vector<char> same_prev(n, 0);
+    for (Index u = 1; u < n; ++u)
+      same_prev[u] = ustart[u + 1] - ustart[u] == ustart[u] - ustart[u - 1] &&
+                     std::equal(ucell.begin() + ustart[u], ucell.begin() + ustart[u + 1], ucell.begin() + ustart[u - 1]);
+    // blocks of each cell
+    blk_start_.assign(nc + 1, 0);
+    pos_start_.assign(nc + 1, 0);
+    blk_.clear();
+    blk_.reserve(std::size_t(nc) * N);
+    for (Index c = 0; c < nc; ++c) {
+      const Index* red = &red_[red_start_[c]];
+      const Index m = red_start_[c + 1] - red_start_[c];
+      for (Index k = 0; k < m;) {
+        if (red[k] < 0) {
+          ++k;
+          continue;
+        }
+        Index e = k + 1;
+        while (e < m && red[e] == red[e - 1] + 1 && same_prev[red[e]]) ++e;
+        blk_.push_back(Block{std::int16_t(k), std::int16_t(e - k), 0});
+        k = e;
+      }
+      blk_start_[c + 1] = Index(blk_.size());
+      const std::int64_t nb = blk_start_[c + 1] - blk_start_[c];
+      pos_start_[c + 1] = pos_start_[c] + nb * nb;
+    }
+    pos_.assign(std::size_t(pos_start_[nc]), -1);
+    // columns, group by group
+    std::vector<Index> outer(n + 1, 0), inner, rank(n, -1), rows;
     inner.reserve(std::size_t(ustart[n]) * 8);
-    for (Index u = 0; u < n; ++u) {
+    for (Index u0 = 0; u0 < n;) {
+      Index g = 1;
+      while (u0 + g < n && same_prev[u0 + g]) ++g;
       rows.clear();
-      for (Index k = ustart[u]; k < ustart[u + 1]; ++k) {
+      for (Index k = ustart[u0]; k < ustart[u0 + 1]; ++k) {
         const Index c = ucell[k];
         for (Index q = red_start_[c]; q < red_start_[c + 1]; ++q) {
           const Index v = red_[q];
-          if (v >= 0 && where[v] != -2 - u) {
-            where[v] = -2 - u;
+          if (v >= 0 && rank[v] != -2 - u0) {
+            rank[v] = -2 - u0;
             rows.push_back(v);
           }
         }
       }
-      if (rows.empty()) throw SolverError("unknown " + std::to_string(u) + " is coupled to nothing");
       std::sort(rows.begin(), rows.end());
-      const Index base = static_cast<Index>(inner.size());
-      for (std::size_t i = 0; i < rows.size(); ++i) where[rows[i]] = base + Index(i);
-      inner.insert(inner.end(), rows.begin(), rows.end());
-      outer[u + 1] = static_cast<Index>(inner.size());
-      for (Index k = ustart[u]; k < ustart[u + 1]; ++k) {
-        const Index c = ucell[k], jc = uloc[k];
-        const Index m = red_start_[c + 1] - red_start_[c];
-        for (Index i = 0; i < m; ++i) {
-          const Index v = red_[red_start_[c] + i];
-          if (v >= 0) pos_[pos_start_[c] + i * m + jc] = where[v];
+      const Index len = Index(rows.size());
+      for (Index i = 0; i < len; ++i) rank[rows[i]] = i;
+      for (Index t = 0; t < g; ++t) {
+        outer[u0 + t + 1] = outer[u0 + t] + len;
+        inner.insert(inner.end(), rows.begin(), rows.end());
+      }
+      for (Index k = ustart[u0]; k < ustart[u0 + 1]; ++k) {
+        const Index c = ucell[k];
+        const Index* red = &red_[red_start_[c]];
+        Block* blk = &blk_[blk_start_[c]];
+        const Index nb = blk_start_[c + 1] - blk_start_[c];
+        for (Index J = 0; J < nb; ++J) {
+          const Index uj = red[blk[J].start];
+          if (uj < u0 || uj >= u0 + g) continue;
+          blk[J].stride = len;
+          for (Index I = 0; I < nb; ++I) pos_[pos_start_[c] + J * nb + I] = outer[uj] + rank[red[blk[I].start]];
         }
       }
-      for (Index v : rows) where[v] = -1;
+      for (Index v : rows) rank[v] = -1;
+      u0 += g;
     }
     matrix_.resize(n, n);
     matrix_.resizeNonZeros(static_cast<Index>(inner.size()));
@@ -234,12 +384,75 @@ class Assembler {
     std::fill(matrix_.valuePtr(), matrix_.valuePtr() + inner.size(), Real(0));
   }
 
+  // Thread schedule: chunks of consecutive simple cells, greedily coloured (a chunk takes the
+  // lowest colour none of its unknowns has been given yet; 64 colours per round, chunks that
+  // find none start a new round of 64).
+  void build_schedule() {
+    const Index nc = n_cells(), n = n_unknowns();
+    chunk_cells_.clear();
+    chunk_start_.assign(1, 0);
+    linked_cells_.clear();
+    for (Index c = 0; c < nc; ++c) {
+      if (general_[c]) {
+        linked_cells_.push_back(c);
+        continue;
+      }
+      chunk_cells_.push_back(c);
+      if (Index(chunk_cells_.size()) - chunk_start_.back() == chunk_size) chunk_start_.push_back(Index(chunk_cells_.size()));
+    }
+    if (chunk_start_.back() != Index(chunk_cells_.size())) chunk_start_.push_back(Index(chunk_cells_.size()));
+    const Index nch = Index(chunk_start_.size()) - 1;
+    std::vector<Index> colour(nch, -1);
+    Index base = 0, left = nch;
+    std::vector<std::uint64_t> used;
+    while (left > 0) {  // one round of up to 64 colours over the chunks still uncoloured
+      used.assign(n, 0);
+      for (Index ch = 0; ch < nch; ++ch) {
+        if (colour[ch] >= 0) continue;
+        std::uint64_t busy = 0;
+        for (Index i = chunk_start_[ch]; i < chunk_start_[ch + 1]; ++i) {
+          const Index c = chunk_cells_[i];
+          for (Index k = red_start_[c]; k < red_start_[c + 1]; ++k)
+            if (red_[k] >= 0) busy |= used[red_[k]];
+        }
+        if (busy == ~std::uint64_t(0)) continue;
+        const int bit = std::countr_one(busy);
+        colour[ch] = base + bit;
+        --left;
+        for (Index i = chunk_start_[ch]; i < chunk_start_[ch + 1]; ++i) {
+          const Index c = chunk_cells_[i];
+          for (Index k = red_start_[c]; k < red_start_[c + 1]; ++k)
+            if (red_[k] >= 0) used[red_[k]] |= std::uint64_t(1) << bit;
+        }
+      }
+      base += 64;
+    }
+    // chunks sorted by colour (stable: chunk order within a colour), empty colours dropped
+    const Index ncol = nch ? *std::max_element(colour.begin(), colour.end()) + 1 : 0;
+    std::vector<Index> count(ncol + 1, 0);
+    for (Index ch = 0; ch < nch; ++ch) ++count[colour[ch] + 1];
+    std::partial_sum(count.begin(), count.end(), count.begin());
+    chunk_order_.assign(nch, 0);
+    {
+      std::vector<Index> fill(count.begin(), count.end() - 1);
+      for (Index ch = 0; ch < nch; ++ch) chunk_order_[fill[colour[ch]]++] = ch;
+    }
+    colour_start_.assign(1, 0);
+    for (Index k = 1; k <= ncol; ++k)
+      if (count[k] > count[k - 1]) colour_start_.push_back(count[k]);
+  }
+
   const DofConstraints* cons_;
   std::vector<CellDofs> dofs_;
   std::vector<char> general_;
   Index n_general_ = 0;
-  std::vector<Index> red_start_, red_, ent_start_, ent_, pos_;
+  std::vector<Index> red_start_, red_, ent_start_, ent_;
+  std::vector<Index> blk_start_;
+  std::vector<Block> blk_;
+  std::vector<Index> pos_;
   std::vector<std::int64_t> pos_start_;  // can exceed 2^31 for big 3D P2 meshes
+  std::vector<Index> chunk_cells_, chunk_start_, chunk_order_, colour_start_, linked_cells_;
+  int threads_ = 1;
   SparseMatrix matrix_;
 };
 

@@ -10,6 +10,7 @@
 #include "alefsi/fem/dofmap.hpp"
 #include "alefsi/la/assembler.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
+#include "alefsi/physics/navier_stokes.hpp"
 #include "alefsi/physics/stokes.hpp"
 
 using namespace alefsi;
@@ -270,4 +271,70 @@ TEST_CASE("threaded assembly is bit-identical to one thread; a throwing kernel i
     CHECK_THROWS_AS(asmb.assemble(Throwing{}, field, &Jt, &rt), SolverError);
   }
   CHECK_THROWS_AS(asmb.set_threads(0), InvalidArgument);
+}
+
+namespace {
+// Compares AleNavierStokesKernel with AleNavierStokesQuadratureKernel cell by cell on a
+// distorted mesh, with every step input set (theta < 1, history, u*, mesh velocity, force).
+template <int D, class Pair, bool Convection>
+void compare_ns_kernels(Linearisation lin) {
+  const auto mesh = distorted_mesh<D>(D == 2 ? 4 : 2);
+  using Space = MixedSpace<D, Pair>;
+  Space space(mesh);
+  const Index nf = space.n_field();
+  VecX prev(nf), hist(nf), ustar(nf);
+  for (Index f = 0; f < nf; ++f) {
+    prev[f] = std::sin(0.7 * f + 0.2);
+    hist[f] = std::cos(0.3 * f);
+    ustar[f] = std::sin(1.9 * f) + 0.3;
+  }
+  std::vector<Vec<D>> vmesh(mesh.n_nodes());
+  for (Index v = 0; v < mesh.n_nodes(); ++v)
+    for (int k = 0; k < D; ++k) vmesh[v][k] = 0.2 * std::sin(2.0 * mesh.node(v)[(k + 1) % D] + k);
+  StepInputs<D> in;
+  in.dt = 0.05;
+  in.theta = 0.5;
+  in.a0 = 1.5;
+  in.previous = &prev;
+  in.history = &hist;
+  in.extrapolated = &ustar;
+  in.mesh_velocity = &vmesh;
+  in.force = [](const Vec<D>& x) {
+    Vec<D> f;
+    for (int i = 0; i < D; ++i) f[i] = std::cos(1.3 * x[i] + i) * std::exp(0.4 * x[(i + 1) % D]);
+    return f;
+  };
+  AleNavierStokesKernel<D, Pair, Convection> fast(space, 1.3, 0.05, lin);
+  AleNavierStokesQuadratureKernel<D, Pair, Convection> ref(space, 1.3, 0.05, lin);
+  fast.set_step(in);
+  ref.set_step(in);
+  Real worst_A = 0, worst_r = 0;
+  for (Index c = 0; c < mesh.n_cells(); ++c) {
+    Eigen::Matrix<Real, Space::n_local, 1> u, r1, r2;
+    Eigen::Matrix<Real, Space::n_local, Space::n_local> A1, A2;
+    for (int i = 0; i < Space::n_local; ++i) u[i] = std::sin(0.9 * c + 1.1 * i);
+    fast.cell(c, u, A1, r1);
+    ref.cell(c, u, A2, r2);
+    worst_A = std::max(worst_A, (A1 - A2).norm() / A2.norm());
+    worst_r = std::max(worst_r, (r1 - r2).norm() / r2.norm());
+  }
+  INFO(D << "D " << Pair::name << (Convection ? "" : " (no convection)")
+         << (lin == Linearisation::newton ? " Newton" : " semi-implicit") << ": worst relative differences A "
+         << worst_A << ", r " << worst_r);
+  CHECK(worst_A <= 1e-12);
+  CHECK(worst_r <= 1e-12);
+}
+}  // namespace
+
+TEST_CASE("Navier-Stokes kernel (reference integrals, exact-degree rule) equals the quadrature kernel",
+          "[la][assembly][navier_stokes][quick]") {
+  for (auto lin : {Linearisation::newton, Linearisation::semi_implicit}) {
+    compare_ns_kernels<2, TaylorHood, true>(lin);
+    compare_ns_kernels<2, P1P1Gls, true>(lin);
+    compare_ns_kernels<3, TaylorHood, true>(lin);
+    compare_ns_kernels<3, P1P1Gls, true>(lin);
+  }
+  compare_ns_kernels<2, TaylorHood, false>(Linearisation::newton);
+  compare_ns_kernels<2, P1P1Gls, false>(Linearisation::newton);
+  compare_ns_kernels<3, TaylorHood, false>(Linearisation::newton);
 }

@@ -338,3 +338,50 @@ TEST_CASE("Navier-Stokes kernel (reference integrals, exact-degree rule) equals 
   compare_ns_kernels<2, P1P1Gls, false>(Linearisation::newton);
   compare_ns_kernels<3, TaylorHood, false>(Linearisation::newton);
 }
+
+TEST_CASE("assembly with partly fixed nodes and a 6-unknown link equals the dense T^T A T", "[la][assembly][quick]") {
+  // component 0 fixed on the outer circle (component 1 free: blocks of one), the inner circle
+  // linked to 6 extra unknowns (a block of 6: the generic scatter path), pressure free
+  const auto mesh = annulus_mesh(0.3, 1.0, 4, 20);
+  using Space = MixedSpace<2, TaylorHood>;
+  Space space(mesh);
+  DofConstraints cons(space.n_field());
+  const Index z = cons.add_unknowns(6);
+  for (Index i : space.velocity().boundary_dofs(tags::outer)) cons.fix(space.velocity_field(i, 0), 0.3);
+  for (Index i : space.velocity().boundary_dofs(tags::inner)) {
+    const Vec<2> x = space.velocity().point(i);
+    const Index ex[] = {z, z + 1, z + 2, z + 3, z + 4, z + 5};
+    const Real w0[] = {1.0, 0.0, -x[1], x[0] * x[0], 0.5, -x[0] * x[1]};
+    const Real w1[] = {0.0, 1.0, x[0], 0.2, x[1] * x[1], x[0]};
+    cons.link(space.velocity_field(i, 0), ex, w0, 0.01);
+    cons.link(space.velocity_field(i, 1), ex, w1, -0.02);
+  }
+  cons.finalize();
+  Assembler<Space::n_local> asmb(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
+  VecX field(space.n_field());
+  for (Index f = 0; f < field.size(); ++f) field[f] = std::sin(1.3 * f);
+  PseudoRandomKernel<Space::n_local> k;
+  SparseMatrix J;
+  VecX r;
+  asmb.assemble(k, field, &J, &r);
+  const Index nf = space.n_field(), nu = cons.n_unknowns();
+  MatX T = MatX::Zero(nf, nu), Af = MatX::Zero(nf, nf);
+  VecX rf = VecX::Zero(nf);
+  for (Index f = 0; f < nf; ++f)
+    for (std::size_t e = 0; e < cons.indices(f).size(); ++e) T(f, cons.indices(f)[e]) = cons.weights(f)[e];
+  for (Index c = 0; c < mesh.n_cells(); ++c) {
+    const auto d = space.cell_field_dofs(c);
+    typename Assembler<Space::n_local>::LocalMat A;
+    typename Assembler<Space::n_local>::LocalVec re;
+    k.cell(c, asmb.gather(c, field), A, re);
+    for (int i = 0; i < Space::n_local; ++i) {
+      rf[d[i]] += re[i];
+      for (int j = 0; j < Space::n_local; ++j) Af(d[i], d[j]) += A(i, j);
+    }
+  }
+  const MatX Jref = T.transpose() * Af * T;
+  CHECK((MatX(J) - Jref).norm() <= 1e-12 * Jref.norm());
+  CHECK((r - T.transpose() * rf).norm() <= 1e-12 * r.norm());
+  // fewer stored positions than DOF pairs (blocks of 2 on the interior nodes)
+  CHECK(asmb.n_positions() < std::size_t(mesh.n_cells()) * Space::n_local * Space::n_local / 2);
+}

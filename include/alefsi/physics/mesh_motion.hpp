@@ -13,33 +13,28 @@
 ///         (DESIGN.md); lambda = 0 keeps it SPD.
 /// The geometry is the one passed to `solve` (the scheme's extrapolated positions), not the
 /// mesh's current coordinates. The sparsity pattern and the symbolic Cholesky analysis are
-/// done once per mesh topology; each solve assembles and factorises numerically.
+/// done once per mesh topology; each solve assembles and factorises numerically. The SPD
+/// solver is a policy: by default CHOLMOD when alefsi was built with SuiteSparse, else Eigen's
+/// SimplicialLLT (la/suitesparse.hpp, `DefaultSpdSolver`).
 ///
 ///     ElasticMeshMotion<2> motion(mesh);
 ///     auto v = motion.solve(X_hat, [&](Index node, const Vec<2>& x) { return wall_velocity(x); });
 #include <array>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "alefsi/core/eigen_sparse.hpp"
 #include "alefsi/fem/constraints.hpp"
 #include "alefsi/la/assembler.hpp"
+#include "alefsi/la/solvers.hpp"
+#include "alefsi/la/suitesparse.hpp"
 #include "alefsi/mesh/mesh.hpp"
-
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wall"
-#pragma GCC diagnostic ignored "-Wextra"
-#endif
-#include <Eigen/SparseCholesky>
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
 
 namespace alefsi {
 
-template <int D>
+template <int D, LinearSolver Solver = DefaultSpdSolver>
 class ElasticMeshMotion {
  public:
   static constexpr int n_local = D * (D + 1);
@@ -85,12 +80,15 @@ class ElasticMeshMotion {
     VecX r;
     asmb_->assemble(k, field0, &J_, &r);
     if (!analysed_) {
-      llt_.analyzePattern(J_);
+      llt_.analyze(J_);
       analysed_ = true;
     }
-    llt_.factorize(J_);
-    if (llt_.info() != Eigen::Success)
-      throw SolverError("mesh-velocity (elasticity) matrix is not positive definite: is the extrapolated mesh valid?");
+    try {
+      llt_.factorize(J_);
+    } catch (const SolverError& e) {
+      throw SolverError(std::string("mesh-velocity (elasticity) matrix: ") + e.what() +
+                        " (is the extrapolated mesh valid?)");
+    }
     const VecX field = cons_.expand(llt_.solve(-r));
     for (std::size_t v = 0; v < x.size(); ++v)
       for (int kk = 0; kk < D; ++kk) out[v][kk] = field[D * Index(v) + kk];
@@ -129,7 +127,7 @@ class ElasticMeshMotion {
   std::vector<Index> boundary_;
   std::unique_ptr<Assembler<n_local>> asmb_;
   SparseMatrix J_;
-  Eigen::SimplicialLLT<SparseMatrix> llt_;
+  Solver llt_;
   bool analysed_ = false;
 };
 

@@ -7,18 +7,25 @@
 //   build/bench/bench/bench_assembly --benchmark_filter='P2P1/2D/(kernel|assemble)/512/'
 //
 // Benchmarks (N = cells per side of rectangle_mesh / box_mesh):
-//   <pair>/<D>D/pattern/N    Assembler construction (cell DOF copy + CSR pattern + positions)
+//   <pair>/<D>D/pattern/N    Assembler construction (cell DOF copy + CSR pattern + positions + schedule)
 //   <pair>/<D>D/kernel/N     gather + StokesKernel::cell over all cells, no scatter
+//   <pair>/<D>D/kernel_quad/N  the same with StokesQuadratureKernel (the former kernel, for reference)
 //   <pair>/<D>D/scatter/N    Assembler::scatter of one fixed element matrix/residual for every cell
 //   <pair>/<D>D/assemble/N   Assembler::assemble (zero J, gather, kernel, scatter), matrix + residual
+//   <pair>/<D>D/assemble_t2/N  the same on 2 threads (Assembler::set_threads(2))
+//   <pair>/<D>D/ns_<lin>[_kernel|_t2]/N  the same (assemble; kernel alone; 2 threads) with
+//                            AleNavierStokesKernel, Newton or semi-implicit (see NsInputs)
+//   <pair>/<D>D/ns_newton_kernel_quad/N  AleNavierStokesQuadratureKernel (the former kernel) alone
 //   <pair>/<D>D/lu_<ord>/N   SparseLu<ord>: analyse, factorise, solve (times as counters), fill
 // Constraints as in Stokes::solve with every boundary tag Dirichlet: every velocity DOF on a
 // boundary facet fixed (lid velocity (1,0[,0]) on the top / ymax side, 0 elsewhere) and
 // pressure DOF 0 pinned. mu = 1, no body force. Single thread.
 //
-// Counters: cells, dofs (unknowns after constraints), nnz, el/s (cells * iterations per CPU
-// second, Google Benchmark's rate basis), GFLOP/s (kernel: the nominal flop count of
-// StokesKernel::cell, see flops_per_cell below), peak_MB (VmHWM of the process during that
+// Timing: every benchmark but lu measures the process CPU time (the CPU column: all threads)
+// and reports rates per wall second (UseRealTime: the Time column is wall time). Counters:
+// cells, dofs (unknowns after constraints), nnz, el/s (cells * iterations per wall second; per
+// CPU second: cells / the CPU column), GFLOP/s (kernel: the nominal flop count of
+// StokesKernel::cell per wall second, see flops_per_cell below), peak_MB (VmHWM of the process during that
 // benchmark: malloc_trim + /proc/self/clear_refs at its start, so it includes the problem, the
 // assembler and whatever the benchmark allocates).
 // LU: analyse_s, factorise_s, solve_s (wall clock) and *_cpu_s (thread CPU time), LU_nnz
@@ -46,6 +53,7 @@
 #include "alefsi/la/assembler.hpp"
 #include "alefsi/la/solvers.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
+#include "alefsi/physics/navier_stokes.hpp"
 #include "alefsi/physics/stokes.hpp"
 
 namespace {
@@ -86,10 +94,16 @@ template <int D, class Pair>
 struct Problem {
   using Space = MixedSpace<D, Pair>;
   using Kernel = StokesKernel<D, Pair>;
+  using QuadKernel = StokesQuadratureKernel<D, Pair>;
+  using NsKernel = AleNavierStokesKernel<D, Pair>;
+  using NsQuadKernel = AleNavierStokesQuadratureKernel<D, Pair>;
   using Asm = Assembler<Space::n_local>;
   static constexpr int lid_tag = D == 2 ? tags::top : tags::ymax;
 
-  explicit Problem(int n) : mesh(make_mesh<D>(n)), space(mesh), cons(space.n_field()), kernel(space, 1.0) {
+  explicit Problem(int n)
+      : mesh(make_mesh<D>(n)), space(mesh), cons(space.n_field()), kernel(space, 1.0), quad_kernel(space, 1.0),
+        ns_newton(space, 1.0, 0.01, Linearisation::newton), ns_semi(space, 1.0, 0.01, Linearisation::semi_implicit),
+        ns_newton_quad(space, 1.0, 0.01, Linearisation::newton) {
     const auto& vel = space.velocity();
     std::vector<char> done(vel.n_dofs(), 0);
     // the lid first so that its edge/corner DOFs take the lid value, as in a driven cavity
@@ -105,6 +119,38 @@ struct Problem {
     cons.fix(space.pressure_field(0), 0.0);
     cons.finalize();
     field = cons.expand(VecX::Zero(cons.n_unknowns()));
+    // NS step inputs (NsInputs): BDF2 (a0 = 3/2), dt = 0.01, theta = 1, smooth non-zero
+    // velocity fields for u^n, the history and u*, a rotating mesh velocity, no body force
+    auto smooth = [&](Real phase) {
+      VecX v = field;
+      for (Index i = 0; i < vel.n_dofs(); ++i) {
+        const Vec<D> x = vel.point(i);
+        for (int k = 0; k < D; ++k) v[space.velocity_field(i, k)] = std::sin(3 * x[k] + phase) * std::cos(2 * x[(k + 1) % D]);
+      }
+      return v;
+    };
+    ns_field = smooth(0.0);
+    previous = smooth(0.1);
+    history = -2.0 * smooth(0.1) + 0.5 * smooth(0.2);
+    extrapolated = smooth(0.05);
+    mesh_velocity.resize(mesh.n_nodes());
+    for (Index v = 0; v < mesh.n_nodes(); ++v) {
+      const Vec<D> x = mesh.node(v);
+      mesh_velocity[v] = Vec<D>::Zero();
+      mesh_velocity[v][0] = 0.1 * (x[1] - 0.5);
+      mesh_velocity[v][1] = -0.1 * (x[0] - 0.5);
+    }
+    StepInputs<D> in;
+    in.dt = 0.01;
+    in.theta = 1;
+    in.a0 = 1.5;
+    in.history = &history;
+    in.previous = &previous;
+    in.extrapolated = &extrapolated;
+    in.mesh_velocity = &mesh_velocity;
+    ns_newton.set_step(in);
+    ns_semi.set_step(in);
+    ns_newton_quad.set_step(in);
   }
 
   std::unique_ptr<Asm> build_assembler() const {
@@ -119,7 +165,11 @@ struct Problem {
   Space space;
   DofConstraints cons;
   Kernel kernel;
-  VecX field;
+  QuadKernel quad_kernel;
+  NsKernel ns_newton, ns_semi;
+  NsQuadKernel ns_newton_quad;
+  VecX field, ns_field, previous, history, extrapolated;
+  std::vector<Vec<D>> mesh_velocity;
   std::unique_ptr<Asm> asmb;
 };
 
@@ -150,11 +200,35 @@ Problem<D, Pair>& problem(int n) {
   return *static_cast<Problem<D, Pair>*>(g_problem.get());
 }
 
-// ---- nominal flop count of StokesKernel::cell --------------------------------------------
-// Counted from the loops as written (one flop per + - *, a multiply-add = 2 flops), with the
-// loop-invariant w * mu (and w * tau) hoisted once per quadrature point; no body force (the
-// velocity load loop is skipped; the GLS load loop still runs with fq = 0). Per quadrature
-// point q:
+// ---- nominal flop counts -------------------------------------------------------------------
+// One flop per + - * (a multiply-add = 2 flops), counted from the code as written, useful lanes
+// only (not the padding of AffineStokesForms' arrays), no body force.
+//
+// StokesKernel::cell (reference integrals, physics/affine_forms.hpp), with np_ = nv (nv + 1) / 2
+// velocity pairs and n = D nv + np:
+//   J, J^-1, det J                     D^2 + (10 in 2D, 50 in 3D)
+//   gradient_pairs: det J J^-1 (D^2), T and B: 2 D^2 (2D - 1) np_
+//   add_viscous per pair: trace (D - 1), * s (1 + D^2), diagonal + (D), += into A (D^2, and
+//     D^2 more for the mirror block when a != b)
+//   add_divergence: D^2 (scale) + D (2D - 1) nv np (contraction) + 4 D nv np (two scaled +=)
+//   add_pressure_laplacian (GLS): J^-1 J^-T (D^2 (2D - 1)) + scale (D^2 + 1), per pressure pair
+//     a <= b: 2 D^2, += (1, mirror 1)
+//   r = A u: 2 n^2
+template <int D, class Pair>
+double flops_per_cell() {
+  using K = StokesKernel<D, Pair>;
+  constexpr double nv = K::nv, np = K::np, n = K::n_local, d = D;
+  const double npairs = nv * (nv + 1) / 2, ppairs = np * (np + 1) / 2;
+  double f = d * d + (D == 2 ? 10 : 50);
+  f += d * d + 2 * d * d * (2 * d - 1) * npairs;
+  f += npairs * ((d - 1) + 1 + d * d + d + d * d) + (npairs - nv) * d * d;
+  f += d * d + d * (2 * d - 1) * nv * np + 4 * d * nv * np;
+  if (Pair::stabilised) f += d * d * (2 * d - 1) + d * d + 1 + ppairs * 2 * d * d + ppairs + (ppairs - np);
+  return f + 2 * n * n;
+}
+
+// StokesQuadratureKernel::cell (the former kernel), with the loop-invariant w * mu (and w * tau)
+// hoisted once per quadrature point. Per quadrature point q:
 //   G = dphi_v[q] * Jinv                     2 nv D^2
 //   viscous (a, b):  dot 2D, * 1, diag +D, off-diag D^2 * (2 mul + 1 add)
 //                                            nv^2 (3D + 1 + 3D^2)
@@ -164,8 +238,8 @@ Problem<D, Pair>& problem(int n) {
 // (2 n^2). The quadrature has 12 (2D) / 24 (3D) points for P2/P1 (degree 6), 6 / 14 for
 // P1/P1 (degree 4).
 template <int D, class Pair>
-double flops_per_cell() {
-  using K = StokesKernel<D, Pair>;
+double quad_flops_per_cell() {
+  using K = StokesQuadratureKernel<D, Pair>;
   constexpr double nv = K::nv, np = K::np, n = K::n_local, d = D;
   const int nq = simplex_quadrature<D>(2 * K::V::degree + 2).size();
   double per_q = 2 * nv * d * d + nv * nv * (3 * d + 1 + 3 * d * d) + 4 * nv * np * d;
@@ -193,6 +267,17 @@ void size_counters(benchmark::State& state, const Asm& asmb) {
 }
 
 // ---- benchmarks ----------------------------------------------------------------------------
+// Rates per wall second (the benchmarks are registered with UseRealTime) and per process-CPU
+// second (MeasureProcessCPUTime: the CPU column covers every thread).
+void rate_counters(benchmark::State& state, double cells_per_iteration, double flops_per_el = 0) {
+  const double el = cells_per_iteration * double(state.iterations());
+  state.counters["el/s"] = benchmark::Counter(el, benchmark::Counter::kIsRate);
+  if (flops_per_el > 0) {
+    state.counters["GFLOP/s"] = benchmark::Counter(el * flops_per_el * 1e-9, benchmark::Counter::kIsRate);
+    state.counters["flop/el"] = flops_per_el;
+  }
+}
+
 template <int D, class Pair>
 void bm_pattern(benchmark::State& state, int n) {
   auto& p = problem<D, Pair>(n);
@@ -204,33 +289,50 @@ void bm_pattern(benchmark::State& state, int n) {
     benchmark::DoNotOptimize(p.asmb->matrix().valuePtr());
   }
   size_counters(state, *p.asmb);
-  const double n_local = Problem<D, Pair>::Space::n_local;
-  state.counters["pos_MB"] = double(p.asmb->n_cells()) * n_local * n_local * sizeof(Index) / 1048576.0;
+  rate_counters(state, double(p.asmb->n_cells()));
+  state.counters["pos_MB"] = double(p.asmb->n_positions()) * sizeof(Index) / 1048576.0;
   state.counters["matrix_MB"] =
       double(p.asmb->matrix().nonZeros()) * (sizeof(Real) + sizeof(Index)) / 1048576.0;
+  state.counters["colours"] = double(p.asmb->n_colours());
   state.counters["peak_MB"] = peak_mb();
 }
 
+// which kernel a benchmark runs
+enum class Which { stokes, stokes_quad, ns_newton, ns_semi, ns_newton_quad };
 template <int D, class Pair>
+struct Select {
+  static const auto& kernel(Problem<D, Pair>& p, std::integral_constant<Which, Which::stokes>) { return p.kernel; }
+  static const auto& kernel(Problem<D, Pair>& p, std::integral_constant<Which, Which::stokes_quad>) { return p.quad_kernel; }
+  static const auto& kernel(Problem<D, Pair>& p, std::integral_constant<Which, Which::ns_newton>) { return p.ns_newton; }
+  static const auto& kernel(Problem<D, Pair>& p, std::integral_constant<Which, Which::ns_semi>) { return p.ns_semi; }
+  static const auto& kernel(Problem<D, Pair>& p, std::integral_constant<Which, Which::ns_newton_quad>) {
+    return p.ns_newton_quad;
+  }
+};
+template <Which W>
+constexpr bool is_ns = W == Which::ns_newton || W == Which::ns_semi || W == Which::ns_newton_quad;
+
+template <int D, class Pair, Which W>
 void bm_kernel(benchmark::State& state, int n) {
   auto& p = problem<D, Pair>(n);
   const auto& asmb = p.assembler();
+  const auto& kernel = Select<D, Pair>::kernel(p, std::integral_constant<Which, W>{});
+  const VecX& field = is_ns<W> ? p.ns_field : p.field;
   typename Problem<D, Pair>::Asm::LocalMat A;
   typename Problem<D, Pair>::Asm::LocalVec r;
   for (auto _ : state) {
     for (Index c = 0; c < asmb.n_cells(); ++c) {
-      const auto u = asmb.gather(c, p.field);
-      p.kernel.cell(c, u, A, r);
+      const auto u = asmb.gather(c, field);
+      kernel.cell(c, u, A, r);
       benchmark::DoNotOptimize(A.data());
       benchmark::DoNotOptimize(r.data());
     }
     benchmark::ClobberMemory();
   }
   size_counters(state, asmb);
-  const double el = double(asmb.n_cells()) * double(state.iterations());
-  state.counters["el/s"] = benchmark::Counter(el, benchmark::Counter::kIsRate);
-  state.counters["GFLOP/s"] = benchmark::Counter(el * flops_per_cell<D, Pair>() * 1e-9, benchmark::Counter::kIsRate);
-  state.counters["flop/el"] = flops_per_cell<D, Pair>();
+  const double flops = W == Which::stokes ? flops_per_cell<D, Pair>()
+                       : W == Which::stokes_quad ? quad_flops_per_cell<D, Pair>() : 0.0;
+  rate_counters(state, double(asmb.n_cells()), flops);
   state.counters["peak_MB"] = peak_mb();
 }
 
@@ -251,25 +353,28 @@ void bm_scatter(benchmark::State& state, int n) {
     benchmark::ClobberMemory();
   }
   size_counters(state, asmb);
-  state.counters["el/s"] =
-      benchmark::Counter(double(asmb.n_cells()) * double(state.iterations()), benchmark::Counter::kIsRate);
+  rate_counters(state, double(asmb.n_cells()));
   state.counters["peak_MB"] = peak_mb();
 }
 
-template <int D, class Pair>
-void bm_assemble(benchmark::State& state, int n) {
+template <int D, class Pair, Which W>
+void bm_assemble(benchmark::State& state, int n, int threads) {
   auto& p = problem<D, Pair>(n);
-  const auto& asmb = p.assembler();
+  auto& asmb = p.assembler();
+  const auto& kernel = Select<D, Pair>::kernel(p, std::integral_constant<Which, W>{});
+  const VecX& field = is_ns<W> ? p.ns_field : p.field;
+  asmb.set_threads(threads);
   SparseMatrix J = asmb.matrix();  // as in Stokes::solve: a separate matrix with the pattern
   VecX r;
   for (auto _ : state) {
-    asmb.assemble(p.kernel, p.field, &J, &r);
+    asmb.assemble(kernel, field, &J, &r);
     benchmark::DoNotOptimize(J.valuePtr());
     benchmark::DoNotOptimize(r.data());
   }
+  asmb.set_threads(1);
   size_counters(state, asmb);
-  state.counters["el/s"] =
-      benchmark::Counter(double(asmb.n_cells()) * double(state.iterations()), benchmark::Counter::kIsRate);
+  rate_counters(state, double(asmb.n_cells()));
+  state.counters["threads"] = threads;
   state.counters["peak_MB"] = peak_mb();
 }
 
@@ -339,17 +444,25 @@ const std::vector<int> lu_amd_2d_th{8, 16, 32};     // AMD(A + A^T): the bad one
 template <int D, class Pair>
 void register_assembly(const std::vector<int>& sizes) {
   const std::string base = std::string(label<Pair>) + "/" + std::to_string(D) + "D/";
+  // big cases run once (MinTime: the first iteration already exceeds it)
+  auto reg = [&](const std::string& name, auto fn, auto... args) {
+    benchmark::RegisterBenchmark(name.c_str(), fn, args...)
+        ->Unit(benchmark::kMillisecond)->MinTime(0.3)->UseRealTime()->MeasureProcessCPUTime();
+  };
   for (int n : sizes) {
-    const std::string s = "/" + std::to_string(n);
-    // big cases run once (MinTime: the first iteration already exceeds it)
-    benchmark::RegisterBenchmark((base + "pattern" + s).c_str(), bm_pattern<D, Pair>, n)
-        ->Unit(benchmark::kMillisecond)->MinTime(0.3);
-    benchmark::RegisterBenchmark((base + "kernel" + s).c_str(), bm_kernel<D, Pair>, n)
-        ->Unit(benchmark::kMillisecond)->MinTime(0.3);
-    benchmark::RegisterBenchmark((base + "scatter" + s).c_str(), bm_scatter<D, Pair>, n)
-        ->Unit(benchmark::kMillisecond)->MinTime(0.3);
-    benchmark::RegisterBenchmark((base + "assemble" + s).c_str(), bm_assemble<D, Pair>, n)
-        ->Unit(benchmark::kMillisecond)->MinTime(0.3);
+    std::string s = "/";  // (not "/" + to_string: GCC 12 -O3 false -Wrestrict)
+    s += std::to_string(n);
+    reg(base + "pattern" + s, bm_pattern<D, Pair>, n);
+    reg(base + "kernel" + s, bm_kernel<D, Pair, Which::stokes>, n);
+    reg(base + "kernel_quad" + s, bm_kernel<D, Pair, Which::stokes_quad>, n);
+    reg(base + "scatter" + s, bm_scatter<D, Pair>, n);
+    reg(base + "assemble" + s, bm_assemble<D, Pair, Which::stokes>, n, 1);
+    reg(base + "assemble_t2" + s, bm_assemble<D, Pair, Which::stokes>, n, 2);
+    reg(base + "ns_newton_kernel" + s, bm_kernel<D, Pair, Which::ns_newton>, n);
+    reg(base + "ns_newton_kernel_quad" + s, bm_kernel<D, Pair, Which::ns_newton_quad>, n);
+    reg(base + "ns_newton" + s, bm_assemble<D, Pair, Which::ns_newton>, n, 1);
+    reg(base + "ns_newton_t2" + s, bm_assemble<D, Pair, Which::ns_newton>, n, 2);
+    reg(base + "ns_semi" + s, bm_assemble<D, Pair, Which::ns_semi>, n, 1);
   }
 }
 

@@ -7,7 +7,8 @@ set -euo pipefail
 mode=${1:-example}
 cd "$(dirname "$0")/.."
 
-packages=(cmake ninja-build g++ libeigen3-dev catch2 python3-vtk9 ccache)
+packages=(cmake ninja-build g++ libeigen3-dev catch2 python3-vtk9 ccache libsuitesparse-dev libopenblas-dev)
+[ "$mode" = example ] && packages+=(python3-matplotlib)  # the example's PNG plots
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -23,8 +24,10 @@ fi
 cmake --preset release
 case "$mode" in
   example)
-    cmake --build --preset release --target stokes_couette
-    ./build/release/examples/stokes_couette --output build/release/output
+    # drafting, kissing and tumbling of two disks (paper 6.2) to t = 0.5 s, a few minutes
+    cmake --build --preset release --target dkt
+    ./build/release/examples/dkt --output build/release/output/dkt
+    /usr/bin/python3 examples/plot_bodies.py build/release/output/dkt
     ;;
   test)
     cmake --build --preset release

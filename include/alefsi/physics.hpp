@@ -1,6 +1,7 @@
 #pragma once
 /// \file physics.hpp
 /// The physics module: Stokes and ALE Navier-Stokes kernels, mesh motion.
+#include "alefsi/physics/collision.hpp"
 #include "alefsi/physics/mesh_motion.hpp"
 #include "alefsi/physics/navier_stokes.hpp"
 #include "alefsi/physics/rigid_body.hpp"

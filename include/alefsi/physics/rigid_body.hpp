@@ -19,6 +19,8 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <numbers>
+#include <string>
 
 #include "alefsi/core/error.hpp"
 #include "alefsi/core/types.hpp"
@@ -39,6 +41,9 @@ struct RigidBody2D {
   /// Slip velocity u_s(r) in the body frame (r = x - x_g rotated back to the initial
   /// orientation); the result is rotated with the body. Empty: no slip.
   std::function<Vec<2>(const Vec<2>& r)> slip;
+  /// > 0: the body is a disk of this radius. Its surface is then kept on the exact circle
+  /// when the mesh is adapted, and collision distances are exact.
+  Real radius = 0;
 
   bool free() const { return !prescribed; }
 
@@ -50,8 +55,22 @@ struct RigidBody2D {
                        inertia);
     }
     ALEFSI_CHECK_ARG(centre.allFinite() && velocity.allFinite(), who, "non-finite initial state");
+    ALEFSI_CHECK_ARG(radius >= 0 && std::isfinite(radius), who + ".radius", "must be >= 0 and finite, got ", radius);
   }
 };
+
+/// A free disk of radius r and density rho_s (per unit length: m = rho_s pi r^2, I = m r^2 / 2).
+inline RigidBody2D disk_body(int tag, const Vec<2>& centre, Real radius, Real density) {
+  ALEFSI_CHECK_ARG(radius > 0 && std::isfinite(radius), "radius", "must be positive and finite, got ", radius);
+  ALEFSI_CHECK_ARG(density > 0 && std::isfinite(density), "density", "must be positive and finite, got ", density);
+  RigidBody2D b;
+  b.tag = tag;
+  b.mass = density * std::numbers::pi * radius * radius;
+  b.inertia = 0.5 * b.mass * radius * radius;
+  b.centre = centre;
+  b.radius = radius;
+  return b;
+}
 
 /// Rows of H(x) for a point at offset r = x - x_g: u_c = sum_C H(c, C) Z_C.
 inline std::array<Vec<3>, 2> rigid_rows(const Vec<2>& r) {

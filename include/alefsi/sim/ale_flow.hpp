@@ -16,6 +16,23 @@
 /// When every boundary facet has a Dirichlet velocity, pressure DOF 0 is pinned and the pressure
 /// shifted to zero mean after each step (as in physics/stokes.hpp).
 ///
+/// Time step changes: the schemes are constant-step multistep formulas, so a step with a dt
+/// different from the previous one restarts the history from the current state (as at t0:
+/// MR/AB start-up steps); a rejected step (exception) leaves the state at t^n untouched.
+///
+/// Remeshing (2D, `set_remeshing`): after each step, if the worst cell quality is below the
+/// trigger or an edge leaves the size band, the mesh is adapted (mesh/adapt/adapt2d.hpp;
+/// disks stay on their exact circles, other bodies' surfaces are kept), every history level
+/// (positions X, velocities and pressures U, mesh velocity V^n) is interpolated to the new
+/// mesh in the current configuration, body nodes and body DOF values are set from the exact
+/// rigid motion of each level, and the DOF maps, patterns, factorisation analysis and
+/// mesh-motion operator are rebuilt.
+///
+/// Collisions (2D, `set_collisions`): the repulsive short-range force of physics/collision.hpp
+/// (eq. 24), with gaps and directions from the bodies' positions at t^{n+1} (known before the
+/// flow solve) and the relative velocity at t^{n+1} (implicit; its derivative enters the
+/// Jacobian's diagonal body blocks, the coupling between two bodies' rows is lagged).
+///
 /// Start-up: a scheme that reads past levels the history does not have yet takes MR/AB steps
 /// (self-starting, local error O(dt^3), so BDF3 keeps its order); the very first MR/AB step
 /// takes X^{-1} = X^0 - dt V^0 with V^0 solved on X^0, and U^{-1} = U^0.
@@ -30,6 +47,8 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "alefsi/core/error.hpp"
@@ -37,10 +56,14 @@
 #include "alefsi/fem/dofmap.hpp"
 #include "alefsi/la/assembler.hpp"
 #include "alefsi/la/solvers.hpp"
+#include "alefsi/mesh/adapt/adapt2d.hpp"
+#include "alefsi/mesh/adapt/transfer.hpp"
 #include "alefsi/mesh/mesh.hpp"
+#include "alefsi/physics/collision.hpp"
 #include "alefsi/physics/mesh_motion.hpp"
 #include "alefsi/physics/navier_stokes.hpp"
 #include "alefsi/physics/rigid_body.hpp"
+#include "alefsi/sim/checkpoint.hpp"
 #include "alefsi/time/schemes.hpp"
 
 namespace alefsi {
@@ -52,14 +75,83 @@ struct FlowOptions {
   Real newton_tolerance = 1e-10;  ///< on the residual's max norm, relative to its first value (+ absolute 1e-13)
 };
 
+/// Remeshing in the time loop (2D). Trigger: worst cell quality (Mesh::quality) below
+/// `trigger_quality`, or (with a size function) an edge with |L - h| / h > adapt.tolerance.
+struct RemeshOptions {
+  bool enabled = true;
+  Real trigger_quality = 0.35;  ///< in [0, 1)
+  /// The fixed outer boundary (walls) as curves, at their place (mesh/generate/mesher2d.hpp).
+  std::vector<BoundaryCurve> walls;
+  /// Target edge length for the bodies' current circles (disk bodies, radius > 0), e.g.
+  /// `[](const auto& disks) { return graded_size(disks, 0.02, 0.2); }`. Empty: the paper's
+  /// comparative value (adapt2d.hpp) and the quality trigger only.
+  std::function<SizeFunction(const std::vector<Circle>& disks)> size;
+  AdaptOptions adapt;  ///< tolerance T, min_quality, smoothing (adapt.size is set from `size`)
+};
+
+/// What the flow did so far (for logs).
+struct FlowStats {
+  int steps = 0, remeshes = 0, history_restarts = 0;
+  int contacts = 0;              ///< active collision contacts in the last step
+  AdaptReport last_adapt;        ///< of the last remesh
+};
+
 struct StepReport {
   int newton_iterations = 0;
   std::vector<Real> residuals;  ///< max-norm residual before each Newton update
   bool startup = false;
+  bool remeshed = false;  ///< the mesh was adapted after the step
   /// Wall time (s) of the step's phases: mesh-velocity solve, assembly (all Newton
-  /// iterations), numeric factorisation (incl. the one-off symbolic analysis), triangular solves.
-  Real t_mesh_velocity = 0, t_assembly = 0, t_factorize = 0, t_solve = 0;
+  /// iterations), numeric factorisation (incl. the one-off symbolic analysis), triangular
+  /// solves, adaptation + transfer + rebuild.
+  Real t_mesh_velocity = 0, t_assembly = 0, t_factorize = 0, t_solve = 0, t_remesh = 0;
 };
+
+template <int D>
+void detail_write_mesh(CheckpointWriter& w, const Mesh<D>& m) {
+  w.section("mesh");
+  std::vector<Real> x(D * std::size_t(m.n_nodes()));
+  for (Index i = 0; i < m.n_nodes(); ++i)
+    for (int c = 0; c < D; ++c) x[D * std::size_t(i) + c] = m.node(i)[c];
+  w.put_vector(x);
+  w.put_vector(m.cells());
+  w.put_vector(m.cell_tags());
+  std::vector<typename Mesh<D>::Facet> facets;
+  std::vector<int> tags;
+  for (Index f : m.boundary_facets()) facets.push_back(m.facet(f)), tags.push_back(m.facet_tag(f));
+  w.put_vector(facets);
+  w.put_vector(tags);
+}
+
+template <int D>
+Mesh<D> detail_read_mesh(CheckpointReader& r) {
+  r.section("mesh");
+  const auto x = r.get_vector<Real>("node coordinates");
+  std::vector<Vec<D>> nodes(x.size() / D);
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    for (int c = 0; c < D; ++c) nodes[i][c] = x[D * i + c];
+  auto cells = r.get_vector<typename Mesh<D>::Cell>("cells");
+  auto cell_tags = r.get_vector<int>("cell tags");
+  const auto facets = r.get_vector<typename Mesh<D>::Facet>("boundary facets");
+  const auto tags = r.get_vector<int>("boundary tags");
+  try {
+    return Mesh<D>(std::move(nodes), std::move(cells), facets, tags, std::move(cell_tags));
+  } catch (const MeshError& e) {
+    r.fail(std::string("invalid mesh: ") + e.what());
+  }
+}
+
+/// The mesh stored in a checkpoint written by AleFlow::save_checkpoint (to build the flow
+/// that `load_checkpoint` restores).
+template <int D>
+Mesh<D> read_checkpoint_mesh(const std::filesystem::path& file) {
+  CheckpointReader r(file);
+  r.section("config");
+  if (r.get<std::int32_t>("dimension") != D) r.fail("written by a flow of another dimension");
+  r.get_string("element pair");
+  r.get_string("scheme");
+  return detail_read_mesh<D>(r);
+}
 
 template <int D, ElementPair Pair, TimeScheme Scheme, bool Convection = true, LinearSolver Solver = SparseLu<>>
 class AleFlow {
@@ -68,19 +160,22 @@ class AleFlow {
   using Kernel = AleNavierStokesKernel<D, Pair, Convection>;
   using TimeFunction = std::function<Vec<D>(const Vec<D>&, Real)>;
 
-  AleFlow(Mesh<D> mesh, FlowOptions opt)
-      : mesh_(std::move(mesh)), opt_(opt), space_(mesh_), kernel_(space_, opt.rho, opt.mu, opt.linearisation),
-        motion_(mesh_) {
+  AleFlow(Mesh<D> mesh, FlowOptions opt) : mesh_(std::move(mesh)), opt_(opt) {
+    ALEFSI_CHECK_ARG(opt.rho >= 0 && std::isfinite(opt.rho), "rho", "fluid density must be >= 0 and finite, got ", opt.rho);
+    ALEFSI_CHECK_ARG(opt.mu > 0 && std::isfinite(opt.mu), "mu", "viscosity must be positive and finite, got ", opt.mu);
     ALEFSI_CHECK_ARG(opt.max_newton >= 1, "max_newton", "must be >= 1");
+    rebuild_discretisation();
     X_[0] = mesh_.coordinates();
-    U_[0] = VecX::Zero(space_.n_field());
+    U_[0] = VecX::Zero(space_->n_field());
   }
 
   AleFlow(const AleFlow&) = delete;  // the space and kernels point into the owned mesh
   AleFlow& operator=(const AleFlow&) = delete;
 
   const Mesh<D>& mesh() const { return mesh_; }
-  const Space& space() const { return space_; }
+  const Space& space() const { return *space_; }
+  const FlowStats& stats() const { return stats_; }
+  std::size_t n_bodies() const { return bodies_.size(); }
   Real time() const { return t_; }
   /// u^n and p^n (p at the scheme's level n - 1 + theta) as a field vector.
   const VecX& field() const { return U_[0]; }
@@ -90,7 +185,7 @@ class AleFlow {
   void set_velocity(int tag, TimeFunction g) {
     require_not_started("set_velocity");
     ALEFSI_CHECK_ARG(g != nullptr, "g", "boundary velocity function is empty");
-    ALEFSI_CHECK_ARG(!space_.velocity().boundary_dofs(tag).empty(), "tag", "no boundary facet has tag ", tag);
+    ALEFSI_CHECK_ARG(!space_->velocity().boundary_dofs(tag).empty(), "tag", "no boundary facet has tag ", tag);
     dirichlet_[tag] = std::move(g);
   }
   void set_mesh_velocity(int tag, TimeFunction g) {
@@ -123,15 +218,15 @@ class AleFlow {
   Real body_angle(std::size_t k) const { return bodies_.at(k).th[0]; }
   Vec<3> body_velocity(std::size_t k) const { return bodies_.at(k).Z[0]; }
   /// Hydrodynamic force and torque (F1, F2, T3) on free body k over the last step, from its
-  /// momentum balance: M delta_l Z / dt - M g - external load.
+  /// momentum balance: M delta_l Z / dt - M g - external load - collision force.
   Vec<3> body_hydrodynamic_load(std::size_t k) const { return bodies_.at(k).load; }
   void set_force(TimeFunction f) { force_ = std::move(f); }
   void set_initial_velocity(const std::function<Vec<D>(const Vec<D>&)>& u0, Real t0 = 0) {
     require_not_started("set_initial_velocity");
     t_ = t0;
-    for (Index i = 0; i < space_.velocity().n_dofs(); ++i) {
-      const Vec<D> val = u0(space_.velocity().point(i));
-      for (int k = 0; k < D; ++k) U_[0][space_.velocity_field(i, k)] = val[k];
+    for (Index i = 0; i < space_->velocity().n_dofs(); ++i) {
+      const Vec<D> val = u0(space_->velocity().point(i));
+      for (int k = 0; k < D; ++k) U_[0][space_->velocity_field(i, k)] = val[k];
     }
   }
 
@@ -139,6 +234,10 @@ class AleFlow {
   StepReport step(Real dt) {
     ALEFSI_CHECK_ARG(dt > 0 && std::isfinite(dt), "dt", "time step must be positive and finite, got ", dt);
     if (!cons_) setup();
+    if (levels_ > 0 && dt != last_dt_) {  // constant-step formulas: restart from the current state
+      levels_ = 0;
+      ++stats_.history_restarts;
+    }
     if (levels_ == 0) {
       set_body_mesh_velocity(X_[0], {1.0, 0.0, 0.0}, t_);
       Vn_ = solve_mesh_velocity(X_[0], U_[0], t_);
@@ -150,7 +249,217 @@ class AleFlow {
     } else {
       rep = step_with<Scheme>(dt);
     }
+    last_dt_ = dt;
+    ++stats_.steps;
+    if constexpr (D == 2)
+      if (remesh_ && remesh_->enabled) {
+        const auto t0 = std::chrono::steady_clock::now();
+        if (remesh_needed()) rep.remeshed = remesh();
+        rep.t_remesh = std::chrono::duration<Real>(std::chrono::steady_clock::now() - t0).count();
+      }
     return rep;
+  }
+
+  /// Remeshing in the time loop (2D); see RemeshOptions. May be called before or between steps.
+  void set_remeshing(RemeshOptions opt)
+    requires(D == 2)
+  {
+    ALEFSI_CHECK_ARG(opt.trigger_quality >= 0 && opt.trigger_quality < 1, "remesh.trigger_quality",
+                     "must be in [0, 1), got ", opt.trigger_quality);
+    remesh_ = std::move(opt);
+  }
+  /// Short-range repulsive collision forces (eq. 24) between bodies and against the walls
+  /// (every boundary facet that is not a body surface); see physics/collision.hpp.
+  void set_collisions(CollisionOptions opt)
+    requires(D == 2)
+  {
+    collision_.emplace(opt);
+    update_collision_walls();
+  }
+  /// Collision force on body k in the last step (F1, F2).
+  Vec<D> body_collision_force(std::size_t k) const { return bodies_.at(k).contact; }
+  /// Gap between body k's surface and the nearest other body or wall, at t^n (disk bodies
+  /// exactly; others from their surface facets); +inf when nothing is within reach.
+  Real body_gap(std::size_t k) const
+    requires(D == 2)
+  {
+    CollisionModel2D model(CollisionOptions{.range = 1e6});
+    if (collision_) model.set_walls(collision_->walls());
+    else model.set_walls(wall_segments());
+    const auto bodies = collision_bodies(0);
+    Real g = std::numeric_limits<Real>::infinity();
+    for (const auto& c : model.contacts(bodies, opt_.mu))
+      if (c.k == int(k) || c.j == int(k)) g = std::min(g, c.gap);
+    return g;
+  }
+
+  /// Adapts the mesh now (2D; needs `set_remeshing` for the walls, size and options) and
+  /// transfers the state. Returns whether the mesh changed.
+  bool remesh()
+    requires(D == 2)
+  {
+    ALEFSI_CHECK_ARG(remesh_.has_value(), "remesh", "call set_remeshing first");
+    std::vector<BoundaryCurve> curves = remesh_->walls;
+    std::vector<Circle> disks;
+    for (const auto& b : bodies_)
+      if (b.data.radius > 0) disks.push_back(Circle{b.xg[0], b.data.radius, b.data.tag});
+    curves.insert(curves.end(), disks.begin(), disks.end());
+    AdaptOptions ao = remesh_->adapt;
+    if (remesh_->size) ao.size = remesh_->size(disks);
+    AdaptReport ar;
+    Mesh<2> m2 = adapt(mesh_, curves, ao, &ar);
+    stats_.last_adapt = ar;
+    if (!ar.changed) return false;
+    // every history level, interpolated in the current configuration
+    const FieldTransfer2D t1(mesh_, m2, 1);
+    const FieldTransfer2D tu(mesh_, m2, Pair::template Velocity<D>::degree);
+    auto move_points = [&](std::vector<Vec<2>>& x) {
+      if (x.empty()) return;
+      std::vector<Real> flat(2 * x.size());
+      for (std::size_t i = 0; i < x.size(); ++i) flat[2 * i] = x[i][0], flat[2 * i + 1] = x[i][1];
+      flat = t1.apply(flat, 2);
+      x.resize(flat.size() / 2);
+      for (std::size_t i = 0; i < x.size(); ++i) x[i] = Vec<2>(flat[2 * i], flat[2 * i + 1]);
+    };
+    const Index nv_old = space_->velocity().n_dofs();
+    auto move_field = [&](VecX& u) {
+      if (u.size() == 0) return;
+      const std::vector<Real> vel(u.data(), u.data() + 2 * nv_old), pre(u.data() + 2 * nv_old, u.data() + u.size());
+      const auto v2 = tu.apply(vel, 2), p2 = t1.apply(pre, 1);
+      u.resize(Index(v2.size() + p2.size()));
+      std::copy(v2.begin(), v2.end(), u.data());
+      std::copy(p2.begin(), p2.end(), u.data() + v2.size());
+    };
+    for (int k = 1; k < 3; ++k) move_points(X_[k]);
+    move_points(Vn_);
+    for (auto& u : U_) move_field(u);
+    X_[0] = m2.coordinates();
+    mesh_ = std::move(m2);
+    rebuild_discretisation();
+    // bodies: surface nodes and their past positions from the exact rigid motion
+    for (auto& b : bodies_) {
+      b.nodes = mesh_.boundary_nodes(b.data.tag);
+      b.r0.clear();
+      for (Index v : b.nodes) b.r0.push_back(rotate(mesh_.node(v) - b.xg[0], -(b.th[0] - b.data.angle)));
+      for (int k = 1; k < 3; ++k)
+        if (!X_[k].empty())
+          for (std::size_t j = 0; j < b.nodes.size(); ++j)
+            X_[k][b.nodes[j]] = b.xg[k] + rotate(b.r0[j], b.th[k] - b.data.angle);
+    }
+    setup();
+    // body DOF values of every level: rigid velocity (+ slip) of that level
+    for (const auto& b : bodies_)
+      for (int k = 0; k < 3; ++k) {
+        if (U_[k].size() == 0 || X_[k].empty()) continue;
+        const Real rot = b.th[k] - b.data.angle;
+        for (Index i : b.dofs) {
+          const Vec<2> r = dof_point(i, X_[k]) - b.xg[k];
+          const Vec<2> v = rigid_velocity(b.Z[k], r) + (b.data.slip ? rotate(b.data.slip(rotate(r, -rot)), rot) : Vec<2>::Zero());
+          for (int c = 0; c < 2; ++c) U_[k][space_->velocity_field(i, c)] = v[c];
+        }
+      }
+    ++stats_.remeshes;
+    after_remesh_ = mesh_badness();
+    return true;
+  }
+
+  /// Writes the whole state at t^n (mesh, every history level, bodies, counters) to `file`,
+  /// atomically (sim/checkpoint.hpp). A flow built on `read_checkpoint_mesh<D>(file)`, given
+  /// the same configuration (options, boundary data, bodies, remeshing, collisions) and then
+  /// `load_checkpoint(file)`, continues bit for bit.
+  void save_checkpoint(const std::filesystem::path& file) const {
+    CheckpointWriter w(file);
+    w.section("config");
+    w.put(std::int32_t(D));
+    w.put_string(Pair::name);
+    w.put_string(Scheme::name);
+    detail_write_mesh(w, mesh_);
+    w.section("state");
+    w.put(t_);
+    w.put(last_dt_);
+    w.put(std::int32_t(levels_));
+    w.put(std::int32_t(stats_.steps));
+    w.put(std::int32_t(stats_.remeshes));
+    w.put(std::int32_t(stats_.history_restarts));
+    w.put(after_remesh_.first);
+    w.put(after_remesh_.second);
+    for (int k = 1; k < 3; ++k) w.put_vector(flatten(X_[k]));
+    for (int k = 0; k < 3; ++k) w.put_vector(U_[k]);
+    w.put_vector(flatten(Vn_));
+    w.section("bodies");
+    w.put(std::uint64_t(bodies_.size()));
+    for (const auto& b : bodies_) {
+      w.put(std::int32_t(b.data.tag));
+      for (int k = 0; k < 3; ++k) {
+        w.put_vector(std::vector<Real>(b.xg[k].data(), b.xg[k].data() + D));
+        w.put(b.th[k]);
+        w.put_vector(std::vector<Real>(b.Z[k].data(), b.Z[k].data() + 3));
+      }
+      w.put_vector(std::vector<Real>(b.load.data(), b.load.data() + 3));
+      w.put_vector(std::vector<Real>(b.contact.data(), b.contact.data() + D));
+      w.put_vector(flatten(b.r0));
+    }
+    w.section("end");
+    w.commit();
+  }
+
+  /// Restores the state written by `save_checkpoint` into a flow that has not stepped yet and
+  /// was built on the checkpoint's mesh (`read_checkpoint_mesh`) with the same configuration.
+  void load_checkpoint(const std::filesystem::path& file) {
+    require_not_started("load_checkpoint");
+    CheckpointReader r(file);
+    r.section("config");
+    if (r.get<std::int32_t>("dimension") != D) r.fail("written by a flow of another dimension");
+    if (r.get_string("element pair") != Pair::name) r.fail("written with another element pair");
+    if (r.get_string("scheme") != Scheme::name) r.fail("written with another time scheme");
+    const Mesh<D> m = detail_read_mesh<D>(r);
+    if (m.n_nodes() != mesh_.n_nodes() || m.n_cells() != mesh_.n_cells() || m.cells() != mesh_.cells() ||
+        m.coordinates() != mesh_.coordinates())
+      r.fail("the flow's mesh is not the checkpoint's (build it with read_checkpoint_mesh)");
+    r.section("state");
+    t_ = r.get<Real>("t");
+    last_dt_ = r.get<Real>("dt");
+    levels_ = r.get<std::int32_t>("levels");
+    stats_.steps = r.get<std::int32_t>("steps");
+    stats_.remeshes = r.get<std::int32_t>("remeshes");
+    stats_.history_restarts = r.get<std::int32_t>("history restarts");
+    after_remesh_.first = r.get<Real>("remesh state");
+    after_remesh_.second = r.get<Real>("remesh state");
+    X_[0] = mesh_.coordinates();
+    for (int k = 1; k < 3; ++k) X_[k] = unflatten(r.get_vector<Real>("positions"));
+    for (int k = 0; k < 3; ++k) U_[k] = r.get_vecx("field");
+    Vn_ = unflatten(r.get_vector<Real>("mesh velocity"));
+    if (U_[0].size() != space_->n_field()) r.fail("field size does not match the mesh");
+    r.section("bodies");
+    if (r.get<std::uint64_t>("body count") != bodies_.size()) r.fail("another number of bodies than this flow's");
+    for (auto& b : bodies_) {
+      if (r.get<std::int32_t>("body tag") != b.data.tag) r.fail("body tags differ from this flow's");
+      for (int k = 0; k < 3; ++k) {
+        const auto xg = r.get_vector<Real>("body centre");
+        const Real th = r.get<Real>("body angle");
+        const auto Z = r.get_vector<Real>("body velocity");
+        if (xg.size() != std::size_t(D) || Z.size() != 3) r.fail("bad body record");
+        for (int c = 0; c < D; ++c) b.xg[k][c] = xg[c];
+        b.th[k] = th;
+        for (int c = 0; c < 3; ++c) b.Z[k][c] = Z[c];
+      }
+      const auto load = r.get_vector<Real>("body load");
+      const auto contact = r.get_vector<Real>("body contact");
+      b.r0 = unflatten(r.get_vector<Real>("body surface"));
+      if (load.size() != 3 || contact.size() != std::size_t(D) || b.r0.size() != b.nodes.size()) r.fail("bad body record");
+      for (int c = 0; c < 3; ++c) b.load[c] = load[c];
+      for (int c = 0; c < D; ++c) b.contact[c] = contact[c];
+    }
+    r.section("end");
+    r.finish();
+    setup();
+  }
+
+  /// Smallest Mesh::quality over the cells.
+  Real worst_quality() const {
+    Real q = 1;
+    for (Index c = 0; c < mesh_.n_cells(); ++c) q = std::min(q, mesh_.quality(c));
+    return q;
   }
 
  private:
@@ -159,19 +468,20 @@ class AleFlow {
   }
 
   void setup() {
-    cons_ = std::make_unique<DofConstraints>(space_.n_field());
-    const auto& vel = space_.velocity();
+    cons_ = std::make_unique<DofConstraints>(space_->n_field());
+    const auto& vel = space_->velocity();
     std::vector<char> done(vel.n_dofs(), 0);
-    dirichlet_dofs_ = fix_velocity_on_tags(space_, dirichlet_, *cons_, done);
+    dirichlet_dofs_ = fix_velocity_on_tags(*space_, dirichlet_, *cons_, done);
     if constexpr (D == 2)
       for (auto& b : bodies_) {
+        b.dofs.clear();
         if (b.data.free()) b.extra = cons_->add_unknowns(3);
         for (Index i : vel.boundary_dofs(b.data.tag)) {
           ALEFSI_CHECK_ARG(!done[i], "body.tag", "body surface (tag ", b.data.tag, ") touches a Dirichlet wall or another body");
           done[i] = 1;
           b.dofs.push_back(i);
           for (int k = 0; k < D; ++k) {
-            const Index f = space_.velocity_field(i, k);
+            const Index f = space_->velocity_field(i, k);
             if (b.data.free()) {
               const Index ex[] = {b.extra, b.extra + 1, b.extra + 2};
               const Real w[] = {0.0, 0.0, 0.0};
@@ -188,10 +498,114 @@ class AleFlow {
       for (const auto& b : bodies_) body |= b.data.tag == tag;
       return body || dirichlet_.count(tag) > 0;
     });
-    if (pinned_) cons_->fix(space_.pressure_field(0), 0.0);
+    if (pinned_) cons_->fix(space_->pressure_field(0), 0.0);
     cons_->finalize();
     asmb_ = std::make_unique<Assembler<Space::n_local>>(
-        mesh_.n_cells(), [&](Index c) { return space_.cell_field_dofs(c); }, *cons_);
+        mesh_.n_cells(), [&](Index c) { return space_->cell_field_dofs(c); }, *cons_);
+    if constexpr (D == 2) {
+      for (auto& b : bodies_) {
+        b.facets.clear();
+        for (Index f : mesh_.boundary_facets())
+          if (mesh_.facet_tag(f) == b.data.tag) b.facets.push_back({mesh_.facet(f)[0], mesh_.facet(f)[1]});
+        if (b.data.radius > 0)
+          for (Index v : b.nodes)
+            ALEFSI_CHECK_ARG(std::abs((mesh_.node(v) - b.xg[0]).norm() - b.data.radius) <= 1e-6 * b.data.radius,
+                             "body.radius", "body with tag ", b.data.tag, ": surface node ", v, " is at distance ",
+                             (mesh_.node(v) - b.xg[0]).norm(), " from the centre, not the radius ", b.data.radius);
+      }
+      update_collision_walls();
+      // a scene with overlapping bodies is refused before the first step (the mesh cannot
+      // show that: two holes share no node, but a user's centre or radius can be wrong)
+      if (stats_.steps == 0)
+        for (const auto& c : overlaps(0))
+          throw InvalidArgument("bodies", "bodies[" + std::to_string(c.k) + "] and bodies[" + std::to_string(c.j) +
+                                              "] overlap (gap " + std::to_string(c.gap) + ")");
+    }
+  }
+
+  // Pairs of bodies whose surfaces overlap (gap <= 0) at level k (-1: t^{n+1}).
+  std::vector<Contact2D> overlaps(int k) const
+    requires(D == 2)
+  {
+    std::vector<Contact2D> out;
+    CollisionModel2D probe(CollisionOptions{.range = 1e-9, .walls = false});
+    for (const auto& c : probe.contacts(collision_bodies(k), opt_.mu))
+      if (c.gap <= 0) out.push_back(c);
+    return out;
+  }
+
+  // Boundary facets that are not body surfaces, as segments at the current positions.
+  std::vector<Segment2D> wall_segments() const
+    requires(D == 2)
+  {
+    std::vector<Segment2D> w;
+    for (Index f : mesh_.boundary_facets()) {
+      bool body = false;
+      for (const auto& b : bodies_) body |= b.data.tag == mesh_.facet_tag(f);
+      if (!body) w.push_back({mesh_.node(mesh_.facet(f)[0]), mesh_.node(mesh_.facet(f)[1])});
+    }
+    return w;
+  }
+  void update_collision_walls() {
+    if constexpr (D == 2)
+      if (collision_) collision_->set_walls(wall_segments());
+  }
+  // The bodies for the collision model at history level k (0: t^n), or at t^{n+1} (k = -1:
+  // the positions placed for the step being solved), with their velocities Z[k] / Zhat.
+  std::vector<CollisionBody2D> collision_bodies(int k) const
+    requires(D == 2)
+  {
+    std::vector<CollisionBody2D> out;
+    for (const auto& b : bodies_) {
+      CollisionBody2D c;
+      c.centre = k < 0 ? b.xg_next : b.xg[k];
+      c.velocity = (k < 0 ? b.Zhat : b.Z[k]).template head<2>();
+      c.radius = b.data.radius;
+      const Real rot = (k < 0 ? b.th_next : b.th[k]) - b.data.angle;
+      auto at = [&](Index v) {
+        const auto it = std::lower_bound(b.nodes.begin(), b.nodes.end(), v);
+        return Vec<2>(c.centre + rotate(b.r0[std::size_t(it - b.nodes.begin())], rot));
+      };
+      c.r_in = std::numeric_limits<Real>::infinity();
+      for (std::size_t j = 0; j < b.r0.size(); ++j) c.r_out = std::max(c.r_out, b.r0[j].norm());
+      for (const auto& f : b.facets) {
+        const Segment2D seg{at(f[0]), at(f[1])};
+        c.r_in = std::min(c.r_in, (detail::closest_on_segment(c.centre, seg) - c.centre).norm());
+        if (c.radius == 0) c.surface.push_back(seg);
+      }
+      if (c.radius > 0) c.r_in = c.r_out = c.radius;
+      out.push_back(std::move(c));
+    }
+    return out;
+  }
+
+  // (worst quality, worst relative size deviation |L - h| / h) of the current mesh
+  std::pair<Real, Real> mesh_badness() const
+    requires(D == 2)
+  {
+    Real dev = 0;
+    if (remesh_->size) {
+      std::vector<Circle> disks;
+      for (const auto& b : bodies_)
+        if (b.data.radius > 0) disks.push_back(Circle{b.xg[0], b.data.radius, b.data.tag});
+      const SizeFunction h = remesh_->size(disks);
+      for (const auto& e : mesh_.edges()) {
+        const Vec<2> a = mesh_.node(e[0]), c = mesh_.node(e[1]);
+        const Real E = h(0.5 * (a + c));
+        dev = std::max(dev, std::abs((a - c).norm() - E) / E);
+      }
+    }
+    return {worst_quality(), dev};
+  }
+  // The trigger, with hysteresis: what the last adaptation could not bring inside the band
+  // (e.g. the cells in a gap narrower than h) triggers again only once it got worse by 10 %.
+  bool remesh_needed() const
+    requires(D == 2)
+  {
+    const auto [q, dev] = mesh_badness();
+    const Real q_lim = std::min(remesh_->trigger_quality, 0.9 * after_remesh_.first);
+    const Real dev_lim = std::max(remesh_->adapt.tolerance, 1.1 * after_remesh_.second);
+    return q < q_lim || (remesh_->size && dev > dev_lim);
   }
 
   // DOF position of scalar velocity DOF i on geometry x.
@@ -211,7 +625,7 @@ class AleFlow {
     std::vector<const TimeFunction*> node_fn(mesh_.n_nodes(), nullptr);
     for (const auto& [tag, g] : mesh_bc_)
       for (Index v : mesh_.boundary_nodes(tag)) node_fn[v] = &g;
-    return motion_.solve(x, [&](Index v, const Vec<D>& xv) {
+    return motion_->solve(x, [&](Index v, const Vec<D>& xv) {
       if (!body_v_.empty() && body_has_v_[v]) return body_v_[v];
       return node_fn[v] ? (*node_fn[v])(xv, t) : Vec<D>(Vec<D>::Zero());
     });
@@ -305,7 +719,7 @@ class AleFlow {
     const Real t1 = t_ + dt;
     for (const auto& [i, tag] : dirichlet_dofs_) {
       const Vec<D> val = dirichlet_.at(tag)(dof_point(i, Xn1), t1);
-      for (int k = 0; k < D; ++k) cons_->set_fixed_value(space_.velocity_field(i, k), val[k]);
+      for (int k = 0; k < D; ++k) cons_->set_fixed_value(space_->velocity_field(i, k), val[k]);
     }
     // body surface velocities at t^{n+1} on X^{n+1}: u = H Z + u_s
     if constexpr (D == 2)
@@ -317,7 +731,7 @@ class AleFlow {
           const Vec<2> us = body.data.slip ? rotate(body.data.slip(rotate(r, -rot)), rot) : Vec<2>::Zero();
           const auto H = rigid_rows(r);
           for (int k = 0; k < 2; ++k) {
-            const Index f = space_.velocity_field(i, k);
+            const Index f = space_->velocity_field(i, k);
             if (body.data.free()) cons_->set_link(f, {H[k].data(), 3}, us[k]);
             else cons_->set_fixed_value(f, H[k].dot(Zp) + us[k]);
           }
@@ -346,7 +760,18 @@ class AleFlow {
         if (force_) f += force_(x, tf);
         return f;
       };
-    kernel_.set_step(in);
+    kernel_->set_step(in);
+    if constexpr (D == 2) {
+      contacts_.clear();
+      if (collision_ && !bodies_.empty()) contacts_ = collision_->contacts(collision_bodies(-1), opt_.mu);
+      stats_.contacts = int(contacts_.size());
+      if (bodies_.size() > 1)
+        for (const auto& c : overlaps(-1)) {  // reject the step: the caller may retry with a smaller dt
+          mesh_.set_coordinates(X_[0]);
+          throw SolverError("bodies[" + std::to_string(c.k) + "] and bodies[" + std::to_string(c.j) +
+                            "] would overlap at t = " + std::to_string(t1) + " (gap " + std::to_string(c.gap) + ")");
+        }
+    }
     // 5. Newton (or one semi-implicit solve)
     clock = std::chrono::steady_clock::now();
     VecX u = cons_->restrict_free(U_[0]);
@@ -358,7 +783,7 @@ class AleFlow {
     const bool newton = opt_.linearisation == Linearisation::newton;
     try {
       for (int it = 0;; ++it) {
-        asmb_->assemble(kernel_, field, &J_, &r);
+        asmb_->assemble(*kernel_, field, &J_, &r);
         add_body_rows<S>(dt, u, r);
         lap(rep.t_assembly);
         const Real rn = r.size() ? r.lpNorm<Eigen::Infinity>() : 0.0;
@@ -370,12 +795,12 @@ class AleFlow {
           throw SolverError("Newton did not converge in " + std::to_string(it) + " iterations (residual " +
                             std::to_string(rn) + ", first " + std::to_string(r0) + ")");
         if (!analysed_) {
-          solver_.analyze(J_);
+          solver_->analyze(J_);
           analysed_ = true;
         }
-        solver_.factorize(J_);
+        solver_->factorize(J_);
         lap(rep.t_factorize);
-        u -= solver_.solve(r);
+        u -= solver_->solve(r);
         lap(rep.t_solve);
         field = cons_->expand(u);
         ++rep.newton_iterations;
@@ -385,10 +810,13 @@ class AleFlow {
       mesh_.set_coordinates(X_[0]);  // the step is rejected: the state stays at t^n
       throw;
     }
-    if (pinned_) shift_pressure_to_zero_mean(space_, field);
+    if (pinned_) shift_pressure_to_zero_mean(*space_, field);
     for (auto& body : bodies_) {
       const Vec<3> Zn1 = body.data.free() ? Vec<3>(u.template segment<3>(cons_->extra_unknown(body.extra))) : body.data.prescribed(t1);
-      if (body.data.free()) body.load = body_inertia<S>(body, Zn1, dt) - body_weight(body) - body.data_external();
+      if (body.data.free()) {
+        body.load = body_inertia<S>(body, Zn1, dt) - body_weight(body) - body.data_external();
+        body.load.template head<D>() -= body.contact;
+      }
       body.Z[2] = body.Z[1], body.Z[1] = body.Z[0], body.Z[0] = Zn1;
       body.xg[2] = body.xg[1], body.xg[1] = body.xg[0], body.xg[0] = body.xg_next;
       body.th[2] = body.th[1], body.th[1] = body.th[0], body.th[0] = body.th_next;
@@ -419,6 +847,8 @@ class AleFlow {
     std::vector<Index> nodes;   // surface mesh nodes
     std::vector<Vec<D>> r0;     // their offsets from the centre at t0
     std::vector<Index> dofs;    // surface velocity DOFs
+    std::vector<std::array<Index, 2>> facets;  // surface facets (2D)
+    Vec<D> contact = Vec<D>::Zero();           // collision force in the last step
     Vec<3> data_external() const { return data.external_load; }
   };
 
@@ -439,7 +869,8 @@ class AleFlow {
   template <TimeScheme S>
   void add_body_rows(Real dt, const VecX& u, VecX& r) {
     const Real a0 = bdf_coefficients(S::flow_bdf)[0];
-    for (const auto& body : bodies_) {
+    for (auto& body : bodies_) {
+      body.contact = Vec<D>::Zero();
       if (!body.data.free()) continue;
       const Index e = cons_->extra_unknown(body.extra);
       const Vec<3> Z = u.template segment<3>(e);
@@ -447,13 +878,63 @@ class AleFlow {
       const Vec<3> m(body.data.mass, body.data.mass, body.data.inertia);
       for (int C = 0; C < 3; ++C) J_.coeffRef(e + C, e + C) += m[C] * a0 / dt;
     }
+    if constexpr (D == 2) {
+      if (contacts_.empty()) return;
+      // velocities at t^{n+1}: the unknowns of free bodies, the given motion of driven ones
+      auto cb = collision_bodies(-1);
+      for (std::size_t k = 0; k < bodies_.size(); ++k)
+        cb[k].velocity = bodies_[k].data.free()
+                             ? Vec<2>(u.template segment<2>(cons_->extra_unknown(bodies_[k].extra)))
+                             : Vec<2>(bodies_[k].data.prescribed(t_ + dt).template head<2>());
+      for (const auto& c : contacts_) {
+        const Vec<2> F = CollisionModel2D::force(c, cb);
+        const Eigen::Matrix<Real, 2, 2> dF = CollisionModel2D::dforce_dvk(c, cb);
+        bodies_[c.k].contact += F;
+        if (c.j >= 0) bodies_[c.j].contact -= F;
+        // rows: r_K -= F_K, r_J += F_K; the diagonal blocks' derivatives (the K-J coupling is lagged)
+        auto add = [&](int b, Real sign) {
+          if (!bodies_[b].data.free()) return;
+          const Index e = cons_->extra_unknown(bodies_[b].extra);
+          r.template segment<2>(e) -= sign * F;
+          for (int i = 0; i < 2; ++i)
+            for (int j = 0; j < 2; ++j) J_.coeffRef(e + i, e + j) -= dF(i, j);
+        };
+        add(c.k, 1);
+        if (c.j >= 0) add(c.j, -1);
+      }
+    }
+  }
+
+  static std::vector<Real> flatten(const std::vector<Vec<D>>& x) {
+    std::vector<Real> out(D * x.size());
+    for (std::size_t i = 0; i < x.size(); ++i)
+      for (int c = 0; c < D; ++c) out[D * i + c] = x[i][c];
+    return out;
+  }
+  static std::vector<Vec<D>> unflatten(const std::vector<Real>& v) {
+    std::vector<Vec<D>> out(v.size() / D);
+    for (std::size_t i = 0; i < out.size(); ++i)
+      for (int c = 0; c < D; ++c) out[i][c] = v[D * i + c];
+    return out;
+  }
+
+  // (re)built for each mesh topology: the space and kernels point into mesh_
+  void rebuild_discretisation() {
+    space_ = std::make_unique<Space>(mesh_);
+    kernel_ = std::make_unique<Kernel>(*space_, opt_.rho, opt_.mu, opt_.linearisation);
+    motion_ = std::make_unique<ElasticMeshMotion<D>>(mesh_);
+    cons_.reset();
+    asmb_.reset();
+    J_ = SparseMatrix();  // the assembler keeps a matrix whose size matches: a flip keeps the size
+    solver_.emplace();
+    analysed_ = false;
   }
 
   Mesh<D> mesh_;
   FlowOptions opt_;
-  Space space_;
-  Kernel kernel_;
-  ElasticMeshMotion<D> motion_;
+  std::unique_ptr<Space> space_;
+  std::unique_ptr<Kernel> kernel_;
+  std::unique_ptr<ElasticMeshMotion<D>> motion_;
   std::map<int, TimeFunction> dirichlet_, mesh_bc_;
   TimeFunction prescribed_, force_;
   Vec<D> gravity_ = Vec<D>::Zero();
@@ -464,10 +945,15 @@ class AleFlow {
   std::unique_ptr<DofConstraints> cons_;
   std::unique_ptr<Assembler<Space::n_local>> asmb_;
   SparseMatrix J_;
-  Solver solver_;
+  std::optional<Solver> solver_;
   bool analysed_ = false, pinned_ = false;
-  Real t_ = 0;
-  int levels_ = 0;  // steps taken (history levels available)
+  Real t_ = 0, last_dt_ = 0;
+  int levels_ = 0;
+  std::optional<RemeshOptions> remesh_;
+  std::pair<Real, Real> after_remesh_{1.0, 0.0};  // mesh_badness() after the last remesh
+  std::optional<CollisionModel2D> collision_;
+  std::vector<Contact2D> contacts_;
+  FlowStats stats_;  // steps taken (history levels available)
   std::array<std::vector<Vec<D>>, 3> X_;
   std::array<VecX, 3> U_;
   std::vector<Vec<D>> Vn_;

@@ -581,6 +581,14 @@ inline std::vector<Vec<2>> curved_edge_midpoints(const Mesh<2>& mesh, const Doma
 
 // ---- ready-made scenes ---------------------------------------------------------------
 
+/// The outline of the channel [0, width] x [0, height], tagged as `alefsi::tags`: bottom 1,
+/// right 2, top 3, left 4 (the walls for `adapt` and `RemeshOptions`).
+inline Polyline channel_outline(Real width, Real height) {
+  return Polyline{{Vec<2>(0, 0), Vec<2>(width, 0), Vec<2>(width, height), Vec<2>(0, height)},
+                  0,
+                  {tags::bottom, tags::right, tags::top, tags::left}};
+}
+
 /// The channel [0, width] x [0, height] with disk-shaped bodies (tags from Circle::tag),
 /// graded from h_body at the disks to h_far (grading 0.2). Outer tags as `alefsi::tags`:
 /// bottom 1, right 2, top 3, left 4.
@@ -589,9 +597,7 @@ inline Mesh<2> channel_with_disks(Real width, Real height, const std::vector<Cir
   ALEFSI_CHECK_ARG(width > 0 && std::isfinite(width), "width", "must be positive and finite, got ", width);
   ALEFSI_CHECK_ARG(height > 0 && std::isfinite(height), "height", "must be positive and finite, got ", height);
   Domain2D dom;
-  dom.outer = Polyline{{Vec<2>(0, 0), Vec<2>(width, 0), Vec<2>(width, height), Vec<2>(0, height)},
-                       0,
-                       {tags::bottom, tags::right, tags::top, tags::left}};
+  dom.outer = channel_outline(width, height);
   for (const Circle& d : disks) dom.holes.emplace_back(d);
   MesherOptions opt;
   opt.size = graded_size(disks, h_body, h_far);

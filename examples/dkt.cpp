@@ -1,0 +1,143 @@
+// dkt — drafting, kissing and tumbling of two disks settling in a channel (paper, section 6.2).
+//
+// What it shows: a whole particulate flow with alefsi — built-in mesher, two free rigid
+// disks coupled monolithically to the fluid, gravity, the repulsive short-range collision
+// force (eq. 24), remeshing in the time loop with transfer of every history level, and the
+// run driver (progress, CSV, VTU/PVD, checkpoints, rejected steps retried with a smaller dt).
+//
+// Set-up (paper 6.2): channel [0, 2] x [0, 6] cm, no-slip walls; disks of diameter 0.25 cm,
+// density 1.5 g/cm^3, centres (1 - offset, 5) and (1, 4.5); fluid density 1, viscosity 0.01
+// g/(cm s); g = (0, -980) cm/s^2. The upper disk is shifted left by `--offset` (default
+// 0.001 cm) to break the symmetry, as Glowinski et al. (1999) and Wan & Turek (2007) do;
+// with an exactly symmetric set-up the disks kiss but tumble only through round-off.
+//
+// Configuration: element pair and scheme at compile time (CMake options ALEFSI_DKT_PAIR =
+// P1P1Gls | TaylorHood, ALEFSI_DKT_SCHEME = BDF2_BDF2E | BDF3_BDF3E | MR_AB | BDF2_AB | BSS;
+// default P1P1Gls + BDF2_BDF2E as in the paper's Figure 5); at run time:
+//   ./dkt [--dt 1e-3] [--t-end 0.5] [--h-body 0.02] [--h-far 0.15] [--offset 0.001]
+//         [--output DIR] [--vtu-every N] [--checkpoint-every N] [--newton] [--restart FILE]
+//         [--no-collisions] [--no-remeshing]
+// What it prints: the mesh size, then a progress line every 10 steps (t, dt, Newton
+// iterations, remeshes, active contacts, worst cell quality, smallest gap, ETA), and a
+// summary: kissing time (the first local minimum of the gap between the disks), positions
+// at t = 0.1, 0.2, 0.3 s, the time split (mesh velocity, assembly, factorisation, solve,
+// remeshing). It writes DIR/bodies.csv (every step), DIR/flow.pvd (every N steps) and
+// DIR/checkpoint.bin; `python3 examples/plot_bodies.py DIR` draws DIR/dkt_*.png.
+// Expected: the trailing disk catches up (drafting), the disks touch near t = 0.15-0.2 s
+// (kissing) and tumble: the trailing disk overtakes; see docs/results.md for the measured
+// kissing times and positions on three mesh / dt levels.
+#include <alefsi/alefsi.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <numbers>
+#include <string>
+
+#ifndef ALEFSI_DKT_PAIR
+#define ALEFSI_DKT_PAIR P1P1Gls
+#endif
+#ifndef ALEFSI_DKT_SCHEME
+#define ALEFSI_DKT_SCHEME BDF2_BDF2E
+#endif
+
+using namespace alefsi;
+#ifdef ALEFSI_HAVE_SUITESPARSE
+using Solver = UmfPackLu;  // when SuiteSparse was found (docs/solvers.md)
+#else
+using Solver = SparseLu<>;
+#endif
+using Flow = AleFlow<2, ALEFSI_DKT_PAIR, ALEFSI_DKT_SCHEME, true, Solver>;
+
+int main(int argc, char** argv) try {
+  Real dt = 1e-3, t_end = 0.5, h_body = 0.02, h_far = 0.15, offset = 0.001;
+  std::filesystem::path out = "output/dkt", restart;
+  int vtu_every = 50, checkpoint_every = 100;
+  bool newton = false, collisions = true, remeshing = true;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto num = [&] {
+      if (i + 1 >= argc) throw InvalidArgument(a, "needs a value");
+      return std::atof(argv[++i]);
+    };
+    if (a == "--dt") dt = num();
+    else if (a == "--t-end") t_end = num();
+    else if (a == "--h-body") h_body = num();
+    else if (a == "--h-far") h_far = num();
+    else if (a == "--offset") offset = num();
+    else if (a == "--vtu-every") vtu_every = int(num());
+    else if (a == "--checkpoint-every") checkpoint_every = int(num());
+    else if (a == "--output" && i + 1 < argc) out = argv[++i];
+    else if (a == "--restart" && i + 1 < argc) restart = argv[++i];
+    else if (a == "--newton") newton = true;
+    else if (a == "--no-collisions") collisions = false;
+    else if (a == "--no-remeshing") remeshing = false;
+    else {
+      std::cerr << "usage: " << argv[0]
+                << " [--dt S] [--t-end S] [--h-body CM] [--h-far CM] [--offset CM] [--output DIR]"
+                   " [--vtu-every N] [--checkpoint-every N] [--newton] [--restart FILE] [--no-collisions] [--no-remeshing]\n";
+      return 2;
+    }
+  }
+  // --- the scene ------------------------------------------------------------------------
+  const Real W = 2, H = 6, R = 0.125, rho_s = 1.5, rho_f = 1, mu = 0.01;
+  const Vec<2> g(0, -980);
+  const int upper = 5, lower = 6;
+  const std::vector<Circle> disks = {{Vec<2>(1 - offset, 5), R, upper}, {Vec<2>(1, 4.5), R, lower}};
+  Mesh<2> mesh = restart.empty() ? channel_with_disks(W, H, disks, h_body, h_far) : read_checkpoint_mesh<2>(restart);
+  std::cout << "DKT with " << Flow::Space::VelocityElement::degree << "/1 elements ("
+            << ALEFSI_DKT_PAIR::name << "), " << ALEFSI_DKT_SCHEME::name << ", " << Solver::name << ", dt " << dt
+            << ": " << mesh.n_nodes()
+            << " nodes, " << mesh.n_cells() << " triangles\n";
+
+  Flow flow(std::move(mesh), {.rho = rho_f, .mu = mu,
+                              .linearisation = newton ? Linearisation::newton : Linearisation::semi_implicit});
+  for (int tag : {tags::bottom, tags::right, tags::top, tags::left})
+    flow.set_velocity(tag, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });
+  for (const Circle& c : disks) flow.add_body(disk_body(c.tag, c.centre, R, rho_s));
+  flow.set_gravity(g);
+  // eq. (24) with delta = R/10, plus the Glowinski spring with range 2 h_body and a force at
+  // contact of 50 net weights: it keeps the disks a cell or two apart (collision.hpp)
+  const Real net_weight = (rho_s - rho_f) * std::numbers::pi * R * R * g.norm();
+  if (collisions) flow.set_collisions({.range = 0.1, .spring_range = 2 * h_body, .spring_force = 50 * net_weight});
+  flow.set_remeshing({.enabled = remeshing,.walls = {channel_outline(W, H)},
+                      .size = [=](const std::vector<Circle>& now) { return graded_size(now, h_body, h_far); },
+                      .adapt = {}});
+  if (!restart.empty()) {
+    flow.load_checkpoint(restart);
+    std::cout << "restarted from " << restart << " at t = " << flow.time() << "\n";
+  }
+
+  // --- the run --------------------------------------------------------------------------
+  // kissing: the first local minimum of the gap between the disks, once below R
+  Real t_kiss = -1, gap_prev = 1e300, t_prev = 0;
+  std::vector<std::pair<Real, std::array<Vec<2>, 2>>> snaps;
+  RunOptions ro{.dt = dt, .t_end = t_end, .output = out, .vtu_every = vtu_every,
+                .checkpoint_every = checkpoint_every};
+  ro.on_step = [&] {
+    const Real gap = (flow.body_centre(0) - flow.body_centre(1)).norm() - 2 * R;
+    if (t_kiss < 0 && gap > gap_prev && gap_prev < R) t_kiss = t_prev;
+    gap_prev = gap, t_prev = flow.time();
+    for (Real ts : {0.1, 0.2, 0.3})
+      if (std::abs(flow.time() - ts) < 0.5 * dt) snaps.push_back({ts, {flow.body_centre(0), flow.body_centre(1)}});
+  };
+  const RunSummary s = run(flow, ro);
+
+  std::cout << std::fixed << std::setprecision(4) << "\nreached t = " << s.t << " in " << s.steps << " steps ("
+            << s.rejected << " rejected), " << s.remeshes << " remeshes, worst quality " << s.worst_quality
+            << ", smallest gap " << std::scientific << std::setprecision(3) << s.min_gap << "\n";
+  std::cout << std::fixed << std::setprecision(4) << "kissing time (first minimum of the gap): "
+            << (t_kiss < 0 ? std::string("not reached") : std::to_string(t_kiss)) << "\n";
+  for (const auto& [ts, x] : snaps)
+    std::cout << "t = " << ts << ": upper (" << x[0][0] << ", " << x[0][1] << "), lower (" << x[1][0] << ", "
+              << x[1][1] << ")\n";
+  std::cout << std::setprecision(2) << "wall " << s.wall_seconds << " s: mesh velocity " << s.t_mesh_velocity
+            << ", assembly " << s.t_assembly << ", factorisation " << s.t_factorize << ", solve " << s.t_solve
+            << ", remeshing " << s.t_remesh << "\n";
+  return 0;
+} catch (const std::exception& e) {
+  std::cerr << "dkt: " << e.what() << "\n";
+  return 1;
+}

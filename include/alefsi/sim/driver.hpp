@@ -1,0 +1,229 @@
+#pragma once
+/// \file sim/driver.hpp
+/// The time loop a user wants around an `AleFlow` (2D bodies): progress lines, VTU/PVD
+/// output, a CSV time series of every body, atomic checkpoints, and rejection of failed
+/// steps with a smaller dt.
+///
+/// `run(flow, options)` advances from flow.time() to options.t_end:
+///  * each step: `flow.step(dt)`; if it throws SolverError (Newton did not converge, NaN) or
+///    MeshError (a cell would invert), the flow is still at t^n (AleFlow guarantees it), so
+///    the step is retried with dt / 2, up to `max_retries` halvings; after `recover_after`
+///    good steps the driver tries twice the dt again, up to the nominal one. Each change of dt
+///    restarts the multistep history (AleFlow). If the retries run out, `run` throws Error
+///    naming t, dt and the last failure; what was written until then stays valid.
+///  * the last step is shortened to land on t_end exactly (within 1e-12 dt).
+///  * output (when `output` is set): `<output>/bodies.csv` (one row per step: t, dt, Newton
+///    iterations, remeshed, worst quality, then per body k: x, y, angle, V1, V2, w,
+///    hydrodynamic force and torque, collision force, gap), `<output>/flow.pvd` + steps every
+///    `vtu_every` steps (velocity, pressure, mesh velocity on the P1 nodes),
+///    `<output>/checkpoint.bin` every `checkpoint_every` steps (atomic; see
+///    AleFlow::save_checkpoint). A restarted run (flow.time() > 0) appends to bodies.csv after
+///    dropping rows later than the restart time, and starts a new PVD series
+///    `flow_from_<step>.pvd`.
+///  * a progress line every `progress_every` steps (and at the end) on `log`.
+///
+///     alefsi::RunOptions opt{.dt = 1e-3, .t_end = 0.5, .output = "out", .vtu_every = 50};
+///     alefsi::RunSummary s = alefsi::run(flow, opt);
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "alefsi/core/error.hpp"
+#include "alefsi/mesh/io/vtu.hpp"
+
+namespace alefsi {
+
+struct RunOptions {
+  Real dt = 1e-3;                   ///< nominal time step (> 0)
+  Real t_end = 1;                   ///< > flow.time()
+  std::filesystem::path output;     ///< folder for CSV / VTU / checkpoints; empty: no files
+  int vtu_every = 0;                ///< 0: no VTU
+  int checkpoint_every = 0;         ///< 0: no checkpoints
+  int progress_every = 10;          ///< 0: no progress lines
+  int max_retries = 6;              ///< dt halvings allowed for one step
+  int recover_after = 20;           ///< good steps before trying a larger dt again
+  std::ostream* log = &std::cout;   ///< progress and remarks; nullptr: silent
+  /// Called after every accepted step (e.g. extra monitoring); may throw to stop the run.
+  std::function<void()> on_step = {};
+
+  void validate() const {
+    ALEFSI_CHECK_ARG(dt > 0 && std::isfinite(dt), "dt", "time step must be positive and finite, got ", dt);
+    ALEFSI_CHECK_ARG(std::isfinite(t_end), "t_end", "must be finite, got ", t_end);
+    ALEFSI_CHECK_ARG(vtu_every >= 0, "vtu_every", "must be >= 0, got ", vtu_every);
+    ALEFSI_CHECK_ARG(checkpoint_every >= 0, "checkpoint_every", "must be >= 0, got ", checkpoint_every);
+    ALEFSI_CHECK_ARG(progress_every >= 0, "progress_every", "must be >= 0, got ", progress_every);
+    ALEFSI_CHECK_ARG(max_retries >= 0, "max_retries", "must be >= 0, got ", max_retries);
+    ALEFSI_CHECK_ARG(recover_after >= 1, "recover_after", "must be >= 1, got ", recover_after);
+  }
+};
+
+struct RunSummary {
+  int steps = 0, rejected = 0, remeshes = 0;
+  Real t = 0, wall_seconds = 0;
+  Real worst_quality = 1;   ///< smallest worst-cell quality seen after any step
+  Real min_gap = std::numeric_limits<Real>::infinity();  ///< smallest body gap seen (bodies or walls)
+  Real t_mesh_velocity = 0, t_assembly = 0, t_factorize = 0, t_solve = 0, t_remesh = 0;  ///< sums (s)
+};
+
+namespace detail {
+
+/// P1 nodal values of the flow's velocity (D components) and pressure, for VTU output.
+template <class Flow>
+void nodal_fields(const Flow& flow, std::vector<Real>& u, std::vector<Real>& p, std::vector<Real>& w) {
+  constexpr int D = Flow::Space::dim;
+  const auto& sp = flow.space();
+  const Index nn = flow.mesh().n_nodes();
+  u.assign(std::size_t(D) * nn, 0);
+  p.assign(std::size_t(nn), 0);
+  w.assign(std::size_t(D) * nn, 0);
+  for (Index v = 0; v < nn; ++v) {
+    for (int c = 0; c < D; ++c) u[D * v + c] = flow.field()[sp.velocity_field(v, c)];  // vertex DOFs come first
+    p[v] = flow.field()[sp.pressure_field(v)];
+    if (!flow.mesh_velocity().empty())
+      for (int c = 0; c < D; ++c) w[D * v + c] = flow.mesh_velocity()[v][c];
+  }
+}
+
+/// Keeps the header and the rows of a CSV whose first column is <= t.
+inline void truncate_csv_after(const std::filesystem::path& file, Real t) {
+  std::ifstream in(file);
+  if (!in) return;
+  std::vector<std::string> keep;
+  std::string line;
+  bool header = true;
+  while (std::getline(in, line)) {
+    if (header || std::stod(line.substr(0, line.find(','))) <= t * (1 + 1e-14)) keep.push_back(line);
+    header = false;
+  }
+  in.close();
+  std::ofstream out(file, std::ios::trunc);
+  for (const auto& l : keep) out << l << '\n';
+}
+
+}  // namespace detail
+
+template <class Flow>
+RunSummary run(Flow& flow, const RunOptions& opt) {
+  opt.validate();
+  ALEFSI_CHECK_ARG(opt.t_end > flow.time(), "t_end", "must exceed the flow's time ", flow.time(), ", got ", opt.t_end);
+  const auto wall0 = std::chrono::steady_clock::now();
+  auto wall = [&] { return std::chrono::duration<Real>(std::chrono::steady_clock::now() - wall0).count(); };
+  const std::size_t nb = flow.n_bodies();
+  const Real t_start = flow.time();
+  RunSummary sum;
+
+  std::ofstream csv;
+  std::unique_ptr<PvdWriter> pvd;
+  if (!opt.output.empty()) {
+    std::filesystem::create_directories(opt.output);
+    const auto csv_path = opt.output / "bodies.csv";
+    const bool restart = t_start > 0 && std::filesystem::exists(csv_path);
+    if (restart) detail::truncate_csv_after(csv_path, t_start);
+    csv.open(csv_path, restart ? std::ios::app : std::ios::trunc);
+    if (!csv) throw IoError("cannot open '" + csv_path.string() + "' for writing");
+    csv << std::setprecision(17);
+    if (!restart) {
+      csv << "t,dt,newton,remeshed,worst_quality";
+      for (std::size_t k = 0; k < nb; ++k)
+        for (const char* n : {"x", "y", "angle", "vx", "vy", "omega", "fx", "fy", "torque", "fcx", "fcy", "gap"})
+          csv << ',' << n << k;
+      csv << '\n';
+    }
+    if (opt.vtu_every > 0) {
+      const std::string name =
+          t_start > 0 ? "flow_from_" + std::to_string(flow.stats().steps) + ".pvd" : std::string("flow.pvd");
+      pvd = std::make_unique<PvdWriter>(opt.output / name);
+    }
+  }
+  std::vector<Real> u, p, w;
+  auto write_vtu_now = [&] {
+    detail::nodal_fields(flow, u, p, w);
+    pvd->write(flow.time(), flow.mesh(), std::vector<VtuField>{{"velocity", 2, u}, {"pressure", 1, p}, {"mesh_velocity", 2, w}});
+  };
+  if (pvd && t_start == 0) write_vtu_now();
+
+  Real dt = opt.dt;
+  int good = 0;
+  auto log = [&](const std::string& s) {
+    if (opt.log) *opt.log << s << std::endl;
+  };
+  while (flow.time() < opt.t_end - 1e-12 * opt.dt) {
+    const Real h = std::min(dt, opt.t_end - flow.time());
+    StepReport rep;
+    int tries = 0;
+    Real h_try = h;
+    for (;;) {
+      try {
+        rep = flow.step(h_try);
+        break;
+      } catch (const SolverError& e) {
+        if (++tries > opt.max_retries)
+          throw Error("step at t = " + std::to_string(flow.time()) + " failed with dt = " + std::to_string(h_try) +
+                      " after " + std::to_string(opt.max_retries) + " retries: " + e.what());
+        log("  rejected step at t = " + std::to_string(flow.time()) + " (dt " + std::to_string(h_try) + "): " + e.what());
+      } catch (const MeshError& e) {
+        if (++tries > opt.max_retries)
+          throw Error("step at t = " + std::to_string(flow.time()) + " failed with dt = " + std::to_string(h_try) +
+                      " after " + std::to_string(opt.max_retries) + " retries: " + e.what());
+        log("  rejected step at t = " + std::to_string(flow.time()) + " (dt " + std::to_string(h_try) + "): " + e.what());
+      }
+      ++sum.rejected;
+      h_try *= 0.5;
+      dt = h_try;
+      good = 0;
+    }
+    if (dt < opt.dt && ++good >= opt.recover_after) dt = std::min(opt.dt, 2 * dt), good = 0;
+    ++sum.steps;
+    sum.t_mesh_velocity += rep.t_mesh_velocity, sum.t_assembly += rep.t_assembly;
+    sum.t_factorize += rep.t_factorize, sum.t_solve += rep.t_solve, sum.t_remesh += rep.t_remesh;
+    const Real q = flow.worst_quality();
+    sum.worst_quality = std::min(sum.worst_quality, q);
+    Real gap_min = std::numeric_limits<Real>::infinity();
+    std::vector<Real> gaps(nb);
+    for (std::size_t k = 0; k < nb; ++k) gap_min = std::min(gap_min, gaps[k] = flow.body_gap(k));
+    sum.min_gap = std::min(sum.min_gap, gap_min);
+    if (csv.is_open()) {
+      csv << flow.time() << ',' << h_try << ',' << rep.newton_iterations << ',' << int(rep.remeshed) << ',' << q;
+      for (std::size_t k = 0; k < nb; ++k) {
+        const auto x = flow.body_centre(k);
+        const auto z = flow.body_velocity(k);
+        const auto f = flow.body_hydrodynamic_load(k);
+        const auto fc = flow.body_collision_force(k);
+        csv << ',' << x[0] << ',' << x[1] << ',' << flow.body_angle(k) << ',' << z[0] << ',' << z[1] << ',' << z[2] << ','
+            << f[0] << ',' << f[1] << ',' << f[2] << ',' << fc[0] << ',' << fc[1] << ',' << gaps[k];
+      }
+      csv << '\n' << std::flush;
+    }
+    const int n = flow.stats().steps;
+    if (pvd && n % opt.vtu_every == 0) write_vtu_now();
+    if (!opt.output.empty() && opt.checkpoint_every > 0 && n % opt.checkpoint_every == 0)
+      flow.save_checkpoint(opt.output / "checkpoint.bin");
+    if (opt.on_step) opt.on_step();
+    const bool last = flow.time() >= opt.t_end - 1e-12 * opt.dt;
+    if (opt.progress_every > 0 && (n % opt.progress_every == 0 || last)) {
+      const Real el = wall(), frac = (flow.time() - t_start) / (opt.t_end - t_start);
+      std::ostringstream s;
+      s << "step " << std::setw(6) << n << "  t " << std::fixed << std::setprecision(4) << flow.time() << "  dt "
+        << std::scientific << std::setprecision(2) << h_try << "  newton " << rep.newton_iterations << "  remeshes "
+        << flow.stats().remeshes << "  contacts " << flow.stats().contacts << std::fixed << std::setprecision(3)
+        << "  q_min " << q << "  gap_min " << std::setprecision(4) << gap_min << std::setprecision(1) << "  wall " << el
+        << " s  ETA " << (frac > 0 ? el * (1 - frac) / frac : 0.0) << " s";
+      log(s.str());
+    }
+  }
+  sum.t = flow.time();
+  sum.remeshes = flow.stats().remeshes;
+  sum.wall_seconds = wall();
+  return sum;
+}
+
+}  // namespace alefsi

@@ -221,3 +221,22 @@ TEST_CASE("DKT, coarse: drafting brings the disks together, the collision forces
   // drafting and kissing: from 0.5 apart to within the spring's range (0.25 + 0.08)
   CHECK(closest < 2 * 0.125 + 0.08);
 }
+
+TEST_CASE("slip built-ins: tangential projection of Q = -B1 e is the squirmer mode B1 sin(theta)", "[slip][quick]") {
+  const Vec<2> e = Vec<2>(1, 2).normalized();
+  const auto proj = tangential_slip(-0.7 * e);
+  const auto mode = squirmer_slip(0.7, 0.0, e);
+  const auto both = squirmer_slip(0.7, 0.3, e);
+  const auto half = tangential_slip(Vec<2>(-1, 0), Vec<2>(1, 0));
+  for (int k = 0; k < 12; ++k) {
+    const Real a = 2 * std::numbers::pi * k / 12 + 0.1;
+    const Vec<2> r = 0.125 * Vec<2>(std::cos(a), std::sin(a)), n = r.normalized();
+    CHECK((proj(r) - mode(r)).norm() < 1e-15);
+    CHECK(std::abs(both(r).dot(n)) < 1e-15);  // tangential
+    // B1 sin(theta) + B2 sin(theta) cos(theta) along the counter-clockwise tangent
+    const Real c = n.dot(e), s = n.dot(Vec<2>(-e[1], e[0]));
+    CHECK(both(r).dot(Vec<2>(-n[1], n[0])) == Approx(0.7 * s + 0.3 * s * c).margin(1e-15));
+    if (r[0] <= 0) CHECK(half(r).norm() == 0);
+    else CHECK(half(r).norm() == Approx(std::abs(n[1])).epsilon(1e-14));
+  }
+}

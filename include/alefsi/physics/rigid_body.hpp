@@ -72,6 +72,34 @@ inline RigidBody2D disk_body(int tag, const Vec<2>& centre, Real radius, Real de
   return b;
 }
 
+/// Slip velocities for RigidBody2D::slip (body frame; n = r / |r|, exact for disks).
+///
+/// `tangential_slip(Q)`: the tangential projection of a constant field Q, u_s = Q - (Q.n) n
+/// (the paper's sections 6.1 and 6.4); with `half` set, only on the half surface r.half > 0
+/// (zero elsewhere). On a disk, Q = -B1 e gives the squirmer mode B1 sin(theta) e_theta
+/// (theta from e), which swims along +e at B1 / 2 in an unbounded 2D fluid (Blake 1971).
+inline std::function<Vec<2>(const Vec<2>&)> tangential_slip(const Vec<2>& Q, const Vec<2>& half = Vec<2>::Zero()) {
+  ALEFSI_CHECK_ARG(Q.allFinite() && half.allFinite(), "Q", "must be finite");
+  return [Q, half](const Vec<2>& r) -> Vec<2> {
+    if (half.squaredNorm() > 0 && r.dot(half) <= 0) return Vec<2>::Zero();
+    const Vec<2> n = r.normalized();
+    return Q - Q.dot(n) * n;
+  };
+}
+/// The squirmer modes u_s = (B1 sin(theta) + B2 sin(theta) cos(theta)) e_theta, theta the angle
+/// of r from the unit swimming axis e (body frame), e_theta its counter-clockwise tangent.
+/// 2D unbounded: swims along e at U = B1 / 2; B2 (pusher < 0, puller > 0) adds no speed.
+inline std::function<Vec<2>(const Vec<2>&)> squirmer_slip(Real B1, Real B2, const Vec<2>& e = Vec<2>(1, 0)) {
+  ALEFSI_CHECK_ARG(std::isfinite(B1) && std::isfinite(B2), "B1", "modes must be finite");
+  ALEFSI_CHECK_ARG(std::abs(e.norm() - 1) < 1e-12, "e", "swimming axis must be a unit vector");
+  return [=](const Vec<2>& r) -> Vec<2> {
+    const Vec<2> n = r.normalized(), ep(-e[1], e[0]);
+    const Real c = n.dot(e), s = n.dot(ep);
+    const Vec<2> et = -s * e + c * ep;
+    return (B1 * s + B2 * s * c) * et;
+  };
+}
+
 /// Rows of H(x) for a point at offset r = x - x_g: u_c = sum_C H(c, C) Z_C.
 inline std::array<Vec<3>, 2> rigid_rows(const Vec<2>& r) {
   return {Vec<3>(1.0, 0.0, -r[1]), Vec<3>(0.0, 1.0, r[0])};

@@ -162,19 +162,19 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
     int tries = 0;
     Real h_try = h;
     for (;;) {
+      auto reject = [&](const Error& e) {
+        if (++tries > opt.max_retries)
+          throw Error("step at t = " + std::to_string(flow.time()) + " failed with dt = " + std::to_string(h_try) +
+                      " after " + std::to_string(opt.max_retries) + " retries: " + e.what());
+        log("  rejected step at t = " + std::to_string(flow.time()) + " (dt " + std::to_string(h_try) + "): " + e.what());
+      };
       try {
         rep = flow.step(h_try);
         break;
-      } catch (const SolverError& e) {
-        if (++tries > opt.max_retries)
-          throw Error("step at t = " + std::to_string(flow.time()) + " failed with dt = " + std::to_string(h_try) +
-                      " after " + std::to_string(opt.max_retries) + " retries: " + e.what());
-        log("  rejected step at t = " + std::to_string(flow.time()) + " (dt " + std::to_string(h_try) + "): " + e.what());
-      } catch (const MeshError& e) {
-        if (++tries > opt.max_retries)
-          throw Error("step at t = " + std::to_string(flow.time()) + " failed with dt = " + std::to_string(h_try) +
-                      " after " + std::to_string(opt.max_retries) + " retries: " + e.what());
-        log("  rejected step at t = " + std::to_string(flow.time()) + " (dt " + std::to_string(h_try) + "): " + e.what());
+      } catch (const SolverError& e) {  // Newton failed, non-finite values, an overlap
+        reject(e);
+      } catch (const MeshError& e) {  // a cell would invert
+        reject(e);
       }
       ++sum.rejected;
       h_try *= 0.5;

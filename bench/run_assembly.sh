@@ -8,9 +8,11 @@
 #   bench/run_assembly.sh lu         # SparseLU, all but the two long cases (~2 min)
 #   bench/run_assembly.sh lu-long    # 2D P2/P1 N = 256 (COLAMD) and 3D P2/P1 N = 12 (~6 min, 9.5 GB peak)
 #   bench/run_assembly.sh all
-#   REPS=5 BIN=build/asm-bench/bench/bench_assembly bench/run_assembly.sh assembly 'P2P1/2D/'
+#   REPS=5 BIN=build/asm-bench/bench/bench_assembly bench/run_assembly.sh assembly 'P2P1/2D'
+#   bench/run_assembly.sh custom 'P2P1/3D/(kernel|assemble)/(8|16)/'   # any filter, REPS repetitions
 #
-# An optional second argument restricts the part to benchmarks matching that regex too.
+# An optional second argument, a name prefix without the trailing slash ('P2P1/2D', '3D'),
+# restricts the part to those benchmarks.
 # REPS (default 3): repetitions of every assembly benchmark (lu parts: 1).
 # Output: build/bench/results/<part>-<date>.{txt,json,min.txt}. Build first:
 #   cmake --preset bench && cmake --build --preset bench --target bench_assembly
@@ -42,15 +44,16 @@ for b in d["benchmarks"]:
     if b.get("run_type") != "iteration":
         continue
     runs.setdefault(b["run_name"], []).append(b)
-print(f"{'benchmark (min over repetitions)':46s} {'reps':>4s} {'wall ms':>10s} {'CPU ms':>10s} {'el/s wall':>10s} {'el/s CPU':>10s} {'GFLOP/s':>8s}")
+print(f"{'benchmark (min over repetitions)':34s} {'reps':>4s} {'wall ms':>10s} {'CPU ms':>10s} {'el/s wall':>10s} {'el/s CPU':>10s} {'GF/s wall':>9s} {'GF/s CPU':>9s}")
 for name, bs in runs.items():
     scale = {"ns": 1e-9, "us": 1e-6, "ms": 1e-3, "s": 1.0}[bs[0]["time_unit"]]
     wall = min(b["real_time"] for b in bs) * scale
     cpu = min(b["cpu_time"] for b in bs) * scale
     cells = bs[0].get("cells", 0)
     flop = bs[0].get("flop/el", 0)
-    gf = f"{cells * flop / wall * 1e-9:8.2f}" if flop else f"{'':8s}"
-    print(f"{name:46s} {len(bs):4d} {wall * 1e3:10.2f} {cpu * 1e3:10.2f} {cells / wall:10.3e} {cells / cpu:10.3e} {gf}")
+    gf = f"{cells * flop / wall * 1e-9:9.2f} {cells * flop / cpu * 1e-9:9.2f}" if flop else ""
+    short = name.split("/min_time")[0].split("/iterations")[0]
+    print(f"{short:34s} {len(bs):4d} {wall * 1e3:10.2f} {cpu * 1e3:10.2f} {cells / wall:10.3e} {cells / cpu:10.3e} {gf}")
 PY
 }
 
@@ -59,12 +62,13 @@ ns='/(ns_newton|ns_newton_kernel|ns_newton_kernel_quad|ns_newton_t2|ns_semi)/'
 lu='P2P1/2D/lu_colamd/(16|32|64|128)/|/lu_amd/|P1P1GLS/2D/lu_colamd/|P2P1/3D/lu_colamd/(4|6|8|10)/|P1P1GLS/3D/lu_colamd/'
 lu_long='P2P1/2D/lu_colamd/256/|P2P1/3D/lu_colamd/12/'
 extra=${2:-}
-with() { [[ -n $extra ]] && echo "($1).*($extra)|($extra).*($1)" || echo "$1"; }
+with() { [[ -n $extra ]] && echo "($extra).*$1" || echo "$1"; }
 case ${1:-all} in
   assembly) run assembly "$(with "$stokes")" "$reps" ;;
   ns) run ns "$(with "$ns")" "$reps" ;;
   lu) run lu "$(with "$lu")" 1 ;;
   lu-long) run lu-long "$(with "$lu_long")" 1 ;;
+  custom) run custom "${2:?custom needs a filter}" "$reps" ;;
   all) run assembly "$stokes" "$reps"; run ns "$ns" "$reps"; run lu "$lu" 1; run lu-long "$lu_long" 1 ;;
-  *) echo "usage: $0 [assembly|ns|lu|lu-long|all] [extra-regex]" >&2; exit 2 ;;
+  *) echo "usage: $0 [assembly|ns|lu|lu-long|all] [name-prefix] | custom <filter>" >&2; exit 2 ;;
 esac

@@ -7,7 +7,7 @@
 ///       `SaddlePointAmdOrdering` (la/ordering.hpp), is AMD on A + A^T with zero-diagonal
 ///       (pressure) unknowns placed after a neighbour, factorised in SparseLU's symmetric mode
 ///       (diagonal pivots unless |a_jj| < pivot_threshold * max_i |a_ij|). Measured on the 2D
-///       P2/P1 Stokes matrix, N = 256 (588k unknowns): 154 M entries in L+U and 13 s, against
+///       P2/P1 Stokes matrix, N = 256 (588k unknowns): 154 M entries in L+U and 9.6 s, against
 ///       630 M and 193 s with `SparseLu<Eigen::COLAMDOrdering<Index>>` (partial pivoting),
 ///       which stays available. Numbers and commands: docs/solvers.md.
 ///       `SparseLu<Eigen::AMDOrdering<Index>>` is plain AMD the right way round (Eigen's

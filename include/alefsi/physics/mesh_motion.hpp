@@ -14,8 +14,8 @@
 /// The geometry is the one passed to `solve` (the scheme's extrapolated positions), not the
 /// mesh's current coordinates. The sparsity pattern and the symbolic Cholesky analysis are
 /// done once per mesh topology; each solve assembles and factorises numerically. The SPD
-/// solver is a policy: by default CHOLMOD when alefsi was built with SuiteSparse, else Eigen's
-/// SimplicialLLT (la/suitesparse.hpp, `DefaultSpdSolver`).
+/// solver is a policy: by default Eigen's SimplicialLLT in 2D, and in 3D CHOLMOD when alefsi
+/// was built with SuiteSparse, else SimplicialLLT (la/suitesparse.hpp, `DefaultSpdSolverFor<D>`).
 ///
 ///     ElasticMeshMotion<2> motion(mesh);
 ///     auto v = motion.solve(X_hat, [&](Index node, const Vec<2>& x) { return wall_velocity(x); });
@@ -34,7 +34,7 @@
 
 namespace alefsi {
 
-template <int D, LinearSolver Solver = DefaultSpdSolver>
+template <int D, LinearSolver Solver = DefaultSpdSolverFor<D>>
 class ElasticMeshMotion {
  public:
   static constexpr int n_local = D * (D + 1);

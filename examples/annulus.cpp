@@ -1,0 +1,413 @@
+// annulus — the paper's section 6.3: fluid between a turning outer cylinder and a free inner one.
+//
+// What it shows: a free rigid body (the inner cylinder, radius R1 = 0.25) driven by the fluid
+// that the outer cylinder (R2 = 1, omega_2 = 1 rad/s from t = 0+) drags along; the ALE flow
+// (alefsi::AleFlow, any of the five schemes, Taylor-Hood or P1/P1-GLS) against the
+// finite-difference solution of the reduced problem (26) (alefsi/reference/annulus.hpp).
+// The outer wall's *mesh* velocity is 0 (only the fluid velocity is driven there: a tangential
+// mesh velocity would move its nodes off the circle); the body's surface nodes follow its exact
+// rigid motion and the interior nodes the elasticity problem (15)-(16).
+//
+// How to run:
+//   annulus table1 [--schemes MR_AB,...] [--pair th|gls] [--h H] [--h-wall HW] [--kmax K]
+//                  [--kref KR] [--ref-scheme S] [--lin newton|semi] [--wall-start moving|rest]
+//                  [--csv FILE]
+//       Table 1: mu = 0.01, rho = 1, rho_1 = 1.25; E = ||u(0.8) - u_h(0.8)||_L2(Omega_h(0.8))
+//       for dt = 0.05 2^-k, k = 0..K, with orders, (a) against the FD reference (N = 6000 cells,
+//       dt = 0.05 / 1024: its own error is ~1e-7) and (b) against a fine-dt FEM solution on the
+//       same mesh (scheme --ref-scheme, default BDF3_BDF3E, dt = 0.05 2^-KR, default KR = K + 3),
+//       which isolates the time error. Also |omega_h - omega| at 0.8 (tiny: the cylinder has
+//       barely started to turn, see docs/results.md). --wall-start: the initial FE velocity on
+//       the outer wall, the wall speed (default) or 0 (AleFlow's default: the flow then starts
+//       O(dt) late and every scheme is first order; docs/results.md).
+//   annulus smooth [same options] [--mu M] [--rho-s R] [--ramp TAU] [--T T] [--dt0 DT]
+//       Time-order study that exercises the coupling: mu = 1, rho_1 = 1.25 (Figure 7 set-up),
+//       outer wall started smoothly, omega_2(t) = 1 - exp(-(t/TAU)^4), TAU = 0.1; errors at
+//       T = 0.4 for dt = DT 2^-k (DT = 0.02): velocity L2 and inner angular velocity.
+//   annulus fig7 [--pair th|gls] [--h H] [--dt DT] [--scheme S] [--csv FILE]
+//       Figure 7: mu = rho_f = 1, t* (the inner cylinder reaches omega = 1/2, half the final
+//       value) against I^ = rho_1 / 64 for rho_1 = 1e-6 .. 1e2, FEM (MR/AB as in the paper)
+//       against the FD reference; CSV (plot: docs/img/annulus_plot.py).
+// What it prints: the tables (markdown) and the CSV files named by --csv.
+// Expected (measured, docs/results.md): every scheme at its design order against the fine-dt
+// FEM solution; against the FD reference the error levels off at the spatial error; t* of the
+// FEM within 1 % of the FD value for every rho_1, no instability.
+#include <alefsi/alefsi.hpp>
+#include <alefsi/reference/annulus.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <utility>
+#include <string>
+#include <vector>
+
+#ifdef ALEFSI_ANNULUS_UMFPACK
+#include <Eigen/UmfPackSupport>
+#endif
+
+using namespace alefsi;
+using std::numbers::pi;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+// --- the linear solver ---------------------------------------------------------------------------
+// The sweeps factorise Taylor-Hood saddle-point matrices of 2e4-1e5 unknowns thousands of times:
+// Eigen's SparseLU (COLAMD) takes ~3 s for 3.5e4 unknowns on this machine, UMFPACK with its
+// symmetric strategy 0.35 s. examples/CMakeLists.txt defines ALEFSI_ANNULUS_UMFPACK when it
+// finds libumfpack; otherwise the library's default SparseLu is used (same results, slower).
+#ifdef ALEFSI_ANNULUS_UMFPACK
+class Umfpack {
+ public:
+  static constexpr const char* name = "UMFPACK (symmetric strategy)";
+  Umfpack() { lu_.umfpackControl()(UMFPACK_STRATEGY) = UMFPACK_STRATEGY_SYMMETRIC; }
+  void analyze(const SparseMatrix& A) { lu_.analyzePattern(A); }
+  void factorize(const SparseMatrix& A) {
+    lu_.factorize(A);
+    if (lu_.info() != Eigen::Success) throw SolverError("UMFPACK factorisation failed");
+  }
+  VecX solve(const VecX& b) {
+    VecX x = lu_.solve(b);
+    if (lu_.info() != Eigen::Success) throw SolverError("UMFPACK solve failed");
+    return x;
+  }
+
+ private:
+  Eigen::UmfPackLU<SparseMatrix> lu_;
+};
+using Solver = Umfpack;
+#else
+using Solver = SparseLu<>;
+#endif
+static_assert(LinearSolver<Solver>, "the annulus example's solver must model LinearSolver");
+
+// --- the set-up ------------------------------------------------------------------------------
+struct Scene {
+  Real r1 = 0.25, r2 = 1.0, rho = 1.0, mu = 0.01, rho_s = 1.25;
+  Real ramp = 0;  // 0: impulsive start (omega_2 = 1 for t > 0); > 0: 1 - exp(-(t/ramp)^4)
+  // Impulsive start: the initial FE field on the outer wall. true: the wall's velocity at t = 0+
+  // (u_h^0 = the Dirichlet data, 0 inside); false: at rest like the fluid (AleFlow's default,
+  // u_h^0 = 0): the wall DOFs then jump within the first step, which the first (MR/AB start-up)
+  // step turns into a ramp over [0, dt]: the flow starts O(dt) late and every scheme is O(dt).
+  bool wall_moving_at_0 = true;
+  Real omega2(Real t) const { return ramp > 0 ? 1 - std::exp(-std::pow(t / ramp, 4)) : 1.0; }
+  Real mass() const { return rho_s * pi * r1 * r1; }
+  Real inertia() const { return 0.5 * mass() * r1 * r1; }  // = rho_s pi R1^4 / 2
+  Real ihat() const { return inertia() / (2 * pi * rho * r1 * r1 * r2 * r2); }  // = rho_s / 64
+  reference::AnnulusProblem fd_problem() const {
+    reference::AnnulusProblem p;
+    p.r1 = r1, p.r2 = r2, p.rho = rho, p.mu = mu, p.inertia = inertia();
+    p.outer_omega = [s = *this](Real t) { return s.omega2(t); };
+    return p;
+  }
+};
+
+struct Settings {
+  std::vector<std::string> schemes{"MR_AB", "BDF2_BDF2E", "BDF2_AB", "BDF3_BDF3E", "BSS"};
+  std::string pair = "th", ref_scheme = "BDF3_BDF3E", csv;
+  Real h = 0.04, h_wall = 0;  // h_wall > 0: graded towards the outer wall, h(x) = min(h, h_wall + 0.25 (R2 - |x|))
+  int kmax = 4, kref = -1;
+  Real dt0 = 0.05, T = 0.8, dt = 0.002;
+  Linearisation lin = Linearisation::newton;
+};
+
+Mesh<2> make_mesh(const Scene& sc, const Settings& s) {
+  if (s.h_wall <= 0) return annulus_unstructured(sc.r1, sc.r2, s.h);
+  Domain2D dom{Circle{Vec<2>::Zero(), sc.r2, tags::outer}, {Circle{Vec<2>::Zero(), sc.r1, tags::inner}}};
+  const Real H = s.h, hw = s.h_wall, R2 = sc.r2;
+  return generate_mesh(dom, MesherOptions{[H, hw, R2](const Vec<2>& x) { return std::min(H, hw + 0.25 * (R2 - x.norm())); }});
+}
+
+// --- one FEM run -------------------------------------------------------------------------------
+// Advances n steps of dt and calls obs(flow, step, report) after each; rigid inner body, driven outer wall.
+template <class Pair, class Scheme, class Obs>
+void simulate(const Mesh<2>& mesh, const Scene& sc, Real dt, int n, Linearisation lin, Obs&& obs) {
+  AleFlow<2, Pair, Scheme, true, Solver> flow(mesh, FlowOptions{sc.rho, sc.mu, lin, 25, 1e-10});
+  flow.set_velocity(tags::outer, [sc](const Vec<2>& x, Real t) { return Vec<2>(sc.omega2(t) * Vec<2>(-x[1], x[0])); });
+  RigidBody2D body;
+  body.tag = tags::inner;
+  body.mass = sc.mass();
+  body.inertia = sc.inertia();
+  flow.add_body(body);
+  if (sc.wall_moving_at_0 && sc.omega2(0) != 0) {
+    std::set<std::pair<Real, Real>> wall;  // positions of the outer wall's velocity DOFs
+    const auto& vel = flow.space().velocity();
+    for (Index i : vel.boundary_dofs(tags::outer)) wall.emplace(vel.point(i)[0], vel.point(i)[1]);
+    flow.set_initial_velocity([&](const Vec<2>& x) {
+      return wall.count({x[0], x[1]}) ? Vec<2>(sc.omega2(0) * Vec<2>(-x[1], x[0])) : Vec<2>(Vec<2>::Zero());
+    });
+  }
+  for (int k = 1; k <= n; ++k) {
+    const StepReport rep = flow.step(dt);
+    obs(flow, k, rep);
+  }
+}
+
+// ||u_h - u||_L2 of the velocity entries of `field` on the space's current mesh.
+template <class Space>
+Real velocity_l2_error(const Space& space, const VecX& field, const std::function<Vec<2>(const Vec<2>&)>& u) {
+  const std::function<Mat<2>(const Vec<2>&)> no_grad = [](const Vec<2>&) { return Mat<2>(Mat<2>::Zero()); };
+  const std::function<Real(const Vec<2>&)> no_p = [](const Vec<2>&) { return 0.0; };
+  return flow_errors(space, field, u, no_grad, no_p).u_l2;
+}
+
+// ||u_h - u_FD e_theta||_L2 on the flow's current mesh.
+template <class Flow>
+Real error_vs_fd(const Flow& flow, const reference::AnnulusSolver& fd) {
+  return velocity_l2_error(flow.space(), flow.field(), [&](const Vec<2>& x) {
+    const Real r = x.norm();
+    return Vec<2>(fd.velocity(r) / r * Vec<2>(-x[1], x[0]));
+  });
+}
+
+// ||u_h - u_ref||_L2 on the flow's current mesh, u_ref given by its field vector on the same
+// mesh topology (the meshes at t differ by the O(dt^p) difference of the mesh motions).
+template <class Flow>
+Real error_vs_field(const Flow& flow, const VecX& ref) {
+  return velocity_l2_error(flow.space(), VecX(flow.field() - ref), [](const Vec<2>&) { return Vec<2>(Vec<2>::Zero()); });
+}
+
+// --- run-time choice of the compile-time types -----------------------------------------------
+template <class F>
+void with_types(const std::string& pair, const std::string& scheme, F&& f) {
+  auto pick = [&]<class Pair>() {
+    if (scheme == "MR_AB") f.template operator()<Pair, MR_AB>();
+    else if (scheme == "BDF2_BDF2E") f.template operator()<Pair, BDF2_BDF2E>();
+    else if (scheme == "BDF2_AB") f.template operator()<Pair, BDF2_AB>();
+    else if (scheme == "BDF3_BDF3E") f.template operator()<Pair, BDF3_BDF3E>();
+    else if (scheme == "BSS") f.template operator()<Pair, BSS>();
+    else throw InvalidArgument("scheme", "unknown scheme " + scheme);
+  };
+  if (pair == "th") pick.template operator()<TaylorHood>();
+  else if (pair == "gls") pick.template operator()<P1P1Gls>();
+  else throw InvalidArgument("pair", "th or gls, got " + pair);
+}
+
+const char* display_name(const std::string& key) {
+  if (key == "MR_AB") return MR_AB::name;
+  if (key == "BDF2_BDF2E") return BDF2_BDF2E::name;
+  if (key == "BDF2_AB") return BDF2_AB::name;
+  if (key == "BDF3_BDF3E") return BDF3_BDF3E::name;
+  return BSS::name;
+}
+
+// The paper's Table 1 (E at t = 0.8, dt = 0.05 2^-k); BSS is not in the table.
+Real paper_table1(const std::string& scheme, int k) {
+  static const Real mr[] = {5.5839e-02, 2.7349e-02, 1.3514e-02, 6.6154e-03, 2.0392e-03};
+  static const Real b2e[] = {4.8643e-02, 1.4622e-02, 3.7499e-03, 9.3618e-04, 5.9122e-04};
+  static const Real b2ab[] = {7.2598e-02, 3.7336e-02, 1.8516e-02, 5.2342e-03, 1.2755e-03};
+  static const Real b3[] = {1.2816e-01, 6.7750e-02, 3.0934e-02, 4.1583e-03, 6.9390e-04};
+  if (k < 0 || k > 4) return NAN;
+  if (scheme == "MR_AB") return mr[k];
+  if (scheme == "BDF2_BDF2E") return b2e[k];
+  if (scheme == "BDF2_AB") return b2ab[k];
+  if (scheme == "BDF3_BDF3E") return b3[k];
+  return NAN;
+}
+
+std::string fmt(const char* f, Real v) {
+  if (!std::isfinite(v)) return "";
+  char b[64];
+  std::snprintf(b, sizeof b, f, v);
+  return b;
+}
+
+// --- Table 1 and the smooth-start study --------------------------------------------------------
+int time_orders(const Scene& sc, const Settings& s, bool paper) {
+  const Mesh<2> mesh = make_mesh(sc, s);
+  const int kref = s.kref >= 0 ? s.kref : s.kmax + 3;
+  const int n0 = int(std::lround(s.T / s.dt0));
+  std::printf("annulus: R1 = %g, R2 = %g, rho = %g, mu = %g, rho_1 = %g (I^ = %.4g), %s start%s; T = %g\n", sc.r1, sc.r2,
+              sc.rho, sc.mu, sc.rho_s, sc.ihat(), sc.ramp > 0 ? "smooth" : "impulsive",
+              sc.ramp > 0 ? "" : sc.wall_moving_at_0 ? " (u_h^0 = wall speed on the wall)" : " (u_h^0 = 0 on the wall)", s.T);
+  std::printf("mesh: %ld nodes, %ld triangles (h = %g%s), pair %s, %s, %s\n", long(mesh.n_nodes()), long(mesh.n_cells()), s.h,
+              s.h_wall > 0 ? (", graded to " + fmt("%g", s.h_wall) + " at the outer wall").c_str() : "",
+              s.pair == "th" ? "P2/P1" : "P1/P1-GLS", s.lin == Linearisation::newton ? "Newton" : "semi-implicit", Solver::name);
+  // FD reference (its error ~1e-7 at these settings: tests/physics/test_annulus.cpp)
+  auto t0 = Clock::now();
+  reference::AnnulusSolver fd(sc.fd_problem(), {6000, s.dt0 / 1024, 2});
+  fd.advance_to(s.T);
+  std::printf("FD reference: N = 6000, dt = %g: omega(T) = %.6e (%.1f s)\n", s.dt0 / 1024, fd.omega(),
+              std::chrono::duration<double>(Clock::now() - t0).count());
+  // fine-dt FEM reference on the same mesh
+  VecX uref;
+  Real wref = 0, eref_fd = 0;
+  t0 = Clock::now();
+  with_types(s.pair, s.ref_scheme, [&]<class Pair, class Scheme>() {
+    const int n = n0 << kref;
+    simulate<Pair, Scheme>(mesh, sc, s.dt0 / (1 << kref), n, s.lin, [&](const auto& flow, int k, const StepReport&) {
+      if (k == n) uref = flow.field(), wref = flow.body_velocity(0)[2], eref_fd = error_vs_fd(flow, fd);
+    });
+  });
+  std::printf("FEM reference: %s, dt = %g: omega(T) = %.6e, E vs FD = %.4e (the spatial error) (%.0f s)\n",
+              display_name(s.ref_scheme), s.dt0 / (1 << kref), wref, eref_fd,
+              std::chrono::duration<double>(Clock::now() - t0).count());
+  std::fflush(stdout);
+  std::ofstream csv;
+  if (!s.csv.empty()) {
+    csv.open(s.csv);
+    csv << "scheme,k,dt,E_fd,order_fd,E_time,order_time,omega,omega_err_fd,omega_err_time,paper_E,newton_avg,wall_s\n";
+  }
+  std::printf("\n| scheme | k | dt | E vs FD | order | E vs fine-dt FEM | order | |w - w_FD| | |w - w_fine| |%s steps/s |\n",
+              paper ? " paper E |" : "");
+  std::printf("|---|---|---|---|---|---|---|---|---|%s---|\n", paper ? "---|" : "");
+  for (const auto& key : s.schemes) {
+    Real prev_fd = NAN, prev_t = NAN;
+    for (int k = 0; k <= s.kmax; ++k) {
+      const Real dt = s.dt0 / (1 << k);
+      const int n = n0 << k;
+      Real efd = NAN, et = NAN, w = NAN;
+      long newton = 0;
+      const auto tk = Clock::now();
+      try {
+        with_types(s.pair, key, [&]<class Pair, class Scheme>() {
+          simulate<Pair, Scheme>(mesh, sc, dt, n, s.lin, [&](const auto& flow, int step, const StepReport& rep) {
+            newton += rep.newton_iterations;
+            if (step == n) efd = error_vs_fd(flow, fd), et = error_vs_field(flow, uref), w = flow.body_velocity(0)[2];
+          });
+        });
+      } catch (const Error& e) {
+        std::printf("| %s | %d | %g | failed: %s |\n", display_name(key), k, dt, e.what());
+        continue;
+      }
+      const double wall = std::chrono::duration<double>(Clock::now() - tk).count();
+      const Real ofd = std::log2(prev_fd / efd), ot = std::log2(prev_t / et);
+      const Real pe = paper_table1(key, k);
+      std::printf("| %s | %d | %.6g | %.4e | %s | %.4e | %s | %.2e | %.2e |%s %.1f |\n", display_name(key), k, dt, efd,
+                  fmt("%.2f", ofd).c_str(), et, fmt("%.2f", ot).c_str(), std::abs(w - fd.omega()), std::abs(w - wref),
+                  paper ? (" " + fmt("%.4e", pe) + " |").c_str() : "", n / wall);
+      std::fflush(stdout);
+      if (csv.is_open())
+        csv << key << ',' << k << ',' << dt << ',' << efd << ',' << fmt("%.4f", ofd) << ',' << et << ','
+            << fmt("%.4f", ot) << ',' << w << ',' << std::abs(w - fd.omega()) << ',' << std::abs(w - wref) << ','
+            << fmt("%.4e", pe) << ',' << Real(newton) / n << ',' << wall << '\n';
+      prev_fd = efd, prev_t = et;
+    }
+  }
+  return 0;
+}
+
+// --- Figure 7 ----------------------------------------------------------------------------------
+int figure7(const Scene& base, const Settings& s) {
+  const Mesh<2> mesh = make_mesh(base, s);
+  const std::string key = s.schemes.size() == 1 ? s.schemes[0] : "MR_AB";
+  std::printf("Figure 7: mu = %g, rho = %g, omega_2 = 1 from t = 0+; FEM %s, %s, h = %g (%ld triangles), dt = %g\n",
+              base.mu, base.rho, display_name(key), s.pair == "th" ? "P2/P1" : "P1/P1-GLS", s.h, long(mesh.n_cells()), s.dt);
+  std::ofstream csv;
+  if (!s.csv.empty()) {
+    csv.open(s.csv);
+    csv << "rho_1,I_hat,tstar_fd,tstar_fem,rel_diff,omega_max_fem,steps,wall_s\n";
+  }
+  std::printf("\n| rho_1 | I^ | t* (FD) | t* (FEM) | rel. diff. | max omega_h | steps |\n|---|---|---|---|---|---|---|\n");
+  // t* by linear interpolation between the two levels around omega = 1/2 (final value 1)
+  auto crossing = [](Real t0, Real w0, Real t1, Real w1) { return t0 + (0.5 - w0) / (w1 - w0) * (t1 - t0); };
+  for (int e = -6; e <= 2; ++e) {
+    Scene sc = base;
+    sc.rho_s = std::pow(10.0, e);
+    reference::AnnulusSolver fd(sc.fd_problem(), {2000, 2e-5, 2});
+    Real tfd = NAN, tp = 0, wp = 0;
+    while (fd.time() < 20) {
+      fd.step();
+      if (fd.omega() >= 0.5) {
+        tfd = crossing(tp, wp, fd.time(), fd.omega());
+        break;
+      }
+      tp = fd.time(), wp = fd.omega();
+    }
+    Real tfem = NAN, wmax = 0;
+    int steps = 0;
+    const auto tk = Clock::now();
+    try {
+      with_types(s.pair, key, [&]<class Pair, class Scheme>() {
+        Real t0 = 0, w0 = 0;
+        const int nmax = int(std::ceil(1.2 * tfd / s.dt)) + 10;  // past t*, max |omega_h| checked on the way
+        simulate<Pair, Scheme>(mesh, sc, s.dt, nmax, s.lin, [&](const auto& flow, int step, const StepReport&) {
+          const Real w = flow.body_velocity(0)[2];
+          wmax = std::max(wmax, std::abs(w));
+          if (!std::isfinite(w)) throw SolverError("non-finite body velocity");
+          if (std::isnan(tfem) && w >= 0.5) tfem = crossing(t0, w0, flow.time(), w), steps = step;
+          t0 = flow.time(), w0 = w;
+        });
+      });
+    } catch (const Error& err) {
+      std::printf("rho_1 = %g failed: %s\n", sc.rho_s, err.what());
+    }
+    const double wall = std::chrono::duration<double>(Clock::now() - tk).count();
+    std::printf("| %g | %.4g | %.5f | %.5f | %.2e | %.5f | %d |\n", sc.rho_s, sc.ihat(), tfd, tfem, tfem / tfd - 1, wmax,
+                steps);
+    std::fflush(stdout);
+    if (csv.is_open())
+      csv << sc.rho_s << ',' << sc.ihat() << ',' << tfd << ',' << tfem << ',' << tfem / tfd - 1 << ',' << wmax << ','
+          << steps << ',' << wall << '\n';
+  }
+  return 0;
+}
+
+std::vector<std::string> split(const std::string& str) {
+  std::vector<std::string> out;
+  std::stringstream ss(str);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: %s table1|smooth|fig7 [options] (see the file comment)\n", argv[0]);
+    return 2;
+  }
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress of long sweeps under nohup
+  const std::string mode = argv[1];
+  Scene sc;
+  Settings s;
+  if (mode == "smooth") sc.mu = 1, sc.ramp = 0.1, s.T = 0.4, s.dt0 = 0.02, s.h = 0.05;
+  if (mode == "fig7") sc.mu = 1, s.schemes = {"MR_AB"};
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (i + 1 >= argc) {
+      std::fprintf(stderr, "%s needs a value\n", a.c_str());
+      return 2;
+    }
+    const std::string v = argv[++i];
+    if (a == "--schemes" || a == "--scheme") s.schemes = split(v);
+    else if (a == "--pair") s.pair = v;
+    else if (a == "--h") s.h = std::atof(v.c_str());
+    else if (a == "--h-wall") s.h_wall = std::atof(v.c_str());
+    else if (a == "--kmax") s.kmax = std::atoi(v.c_str());
+    else if (a == "--kref") s.kref = std::atoi(v.c_str());
+    else if (a == "--ref-scheme") s.ref_scheme = v;
+    else if (a == "--lin") s.lin = v == "semi" ? Linearisation::semi_implicit : Linearisation::newton;
+    else if (a == "--csv") s.csv = v;
+    else if (a == "--mu") sc.mu = std::atof(v.c_str());
+    else if (a == "--rho-s") sc.rho_s = std::atof(v.c_str());
+    else if (a == "--ramp") sc.ramp = std::atof(v.c_str());
+    else if (a == "--T") s.T = std::atof(v.c_str());
+    else if (a == "--dt0") s.dt0 = std::atof(v.c_str());
+    else if (a == "--dt") s.dt = std::atof(v.c_str());
+    else if (a == "--wall-start") sc.wall_moving_at_0 = v != "rest";
+    else {
+      std::fprintf(stderr, "unknown option %s\n", a.c_str());
+      return 2;
+    }
+  }
+  try {
+    if (mode == "table1") return time_orders(sc, s, true);
+    if (mode == "smooth") return time_orders(sc, s, false);
+    if (mode == "fig7") return figure7(sc, s);
+    std::fprintf(stderr, "unknown mode %s\n", mode.c_str());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+}

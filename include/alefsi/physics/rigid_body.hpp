@@ -1,7 +1,9 @@
 #pragma once
 /// \file physics/rigid_body.hpp
-/// Rigid bodies in 2D: state, the rigid-velocity operator H of eq. (8)-(9), and the body's
-/// place in the monolithic system.
+/// Rigid bodies in 2D (3 DOF) and 3D (6 DOF): state, the rigid-velocity operator H of
+/// eq. (8)-(9), the body's place in the monolithic system, and `RigidBodyTraits<D>`: what
+/// differs between 2D and 3D bodies (number of rigid DOFs, rows of H, the inertia term and its
+/// Jacobian, the orientation and its update), read by sim/ale_flow.hpp.
 ///
 /// A body is a hole of the fluid mesh whose surface facets carry `tag`. Its velocity is
 /// Z = (V1, V2, w3): the velocity of a surface point x is H(x) Z + u_s(x) with
@@ -16,6 +18,13 @@
 ///     RigidBody2D disk{.tag = 5, .mass = pi * r * r * rho_s, .inertia = 0.5 * mass * r * r,
 ///                      .centre = {1.0, 4.5}};
 ///     flow.add_body(disk);
+///
+/// In 3D (`RigidBody3D`), Z = (V, w) in world axes, H(x) = [I | -[x - x_g]_x], the orientation
+/// is a unit quaternion q (body frame -> world), and the rotation rows are the Newton-Euler
+/// equation in world axes, I_w (delta_l w) / dt + w x (I_w w) with I_w = R(q) I_body R(q)^T.
+///
+///     auto ball = sphere_body(7, Vec<3>(0, 0, 0), 0.5, 1.0);   // m = rho 4/3 pi r^3, I = 2/5 m r^2
+///     flow3d.add_body(ball);
 #include <array>
 #include <cmath>
 #include <functional>
@@ -112,5 +121,201 @@ inline Vec<2> rotate(const Vec<2>& v, Real angle) {
 
 /// Rigid velocity V + w x r.
 inline Vec<2> rigid_velocity(const Vec<3>& Z, const Vec<2>& r) { return {Z[0] - Z[2] * r[1], Z[1] + Z[2] * r[0]}; }
+
+/// A rigid body in 3D. The velocity of a surface point x (offset r = x - x_g) is
+///     u = V + w x r + R(q) u_s(R(q)^T r),
+/// with Z = (V, w) in world axes and R(q) the rotation of the unit quaternion q, which maps the
+/// body frame (where `inertia` and `slip` are given) to world axes.
+struct RigidBody3D {
+  int tag = 0;                      ///< boundary tag of the body's surface
+  Real mass = 0;                    ///< m
+  Mat<3> inertia = Mat<3>::Zero();  ///< inertia tensor about the centre of mass, body frame (SPD)
+  Vec<3> centre = Vec<3>::Zero();   ///< centre of mass at t0
+  Eigen::Quaternion<Real> orientation = Eigen::Quaternion<Real>::Identity();  ///< q at t0 (unit)
+  Vec<6> velocity = Vec<6>::Zero();  ///< Z at t0: (V1, V2, V3, w1, w2, w3), world axes
+  /// If set, the body is driven: Z(t) is given and the body has no unknowns.
+  std::function<Vec<6>(Real t)> prescribed;
+  /// A constant external force and torque (F1, F2, F3, T1, T2, T3), world axes, on a free body
+  /// (besides gravity; the torque is about the centre of mass).
+  Vec<6> external_load = Vec<6>::Zero();
+  /// Slip velocity u_s(r) in the body frame (r in body axes); the result is rotated with the
+  /// body. Empty: no slip.
+  std::function<Vec<3>(const Vec<3>& r)> slip;
+  /// > 0: the body is a sphere of this radius (informative; surface nodes are checked against it).
+  Real radius = 0;
+
+  bool free() const { return !prescribed; }
+
+  void validate(std::size_t index) const {
+    const std::string who = "bodies[" + std::to_string(index) + "]";
+    if (free()) {
+      ALEFSI_CHECK_ARG(mass > 0 && std::isfinite(mass), who + ".mass", "must be positive and finite, got ", mass);
+      ALEFSI_CHECK_ARG(inertia.allFinite() && (inertia - inertia.transpose()).norm() <= 1e-12 * inertia.norm(),
+                       who + ".inertia", "must be a finite symmetric 3x3 tensor");
+      const Eigen::SelfAdjointEigenSolver<Mat<3>> es(inertia, Eigen::EigenvaluesOnly);
+      ALEFSI_CHECK_ARG(es.eigenvalues().minCoeff() > 0, who + ".inertia",
+                       "must be positive definite, smallest eigenvalue ", es.eigenvalues().minCoeff());
+    }
+    ALEFSI_CHECK_ARG(orientation.coeffs().allFinite() && std::abs(orientation.norm() - 1) <= 1e-12,
+                     who + ".orientation", "must be a unit quaternion, |q| = ", orientation.norm());
+    ALEFSI_CHECK_ARG(centre.allFinite() && velocity.allFinite(), who, "non-finite initial state");
+    ALEFSI_CHECK_ARG(external_load.allFinite(), who + ".external_load", "must be finite");
+    ALEFSI_CHECK_ARG(radius >= 0 && std::isfinite(radius), who + ".radius", "must be >= 0 and finite, got ", radius);
+  }
+};
+
+/// A free sphere of radius r and density rho_s: m = rho_s 4/3 pi r^3, I = 2/5 m r^2 Id.
+inline RigidBody3D sphere_body(int tag, const Vec<3>& centre, Real radius, Real density) {
+  ALEFSI_CHECK_ARG(radius > 0 && std::isfinite(radius), "radius", "must be positive and finite, got ", radius);
+  ALEFSI_CHECK_ARG(density > 0 && std::isfinite(density), "density", "must be positive and finite, got ", density);
+  RigidBody3D b;
+  b.tag = tag;
+  b.mass = density * 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
+  b.inertia = 0.4 * b.mass * radius * radius * Mat<3>::Identity();
+  b.centre = centre;
+  b.radius = radius;
+  return b;
+}
+
+/// [v]_x, the matrix of v x (.).
+inline Mat<3> skew(const Vec<3>& v) {
+  Mat<3> s;
+  s << 0, -v[2], v[1], v[2], 0, -v[0], -v[1], v[0], 0;
+  return s;
+}
+
+/// Rows of H(x) = [I | -[r]_x] for a point at offset r = x - x_g: u_c = H(c, :) Z.
+inline std::array<Vec<6>, 3> rigid_rows(const Vec<3>& r) {
+  Vec<6> h0, h1, h2;
+  h0 << 1, 0, 0, 0, r[2], -r[1];
+  h1 << 0, 1, 0, -r[2], 0, r[0];
+  h2 << 0, 0, 1, r[1], -r[0], 0;
+  return {h0, h1, h2};
+}
+
+/// Rigid velocity V + w x r (3D).
+inline Vec<3> rigid_velocity(const Vec<6>& Z, const Vec<3>& r) {
+  return Z.head<3>() + Vec<3>(Z.tail<3>()).cross(r);
+}
+
+/// Rotation by the vector phi (angle |phi| about phi / |phi|) as a unit quaternion.
+inline Eigen::Quaternion<Real> rotation_quaternion(const Vec<3>& phi) {
+  const Real a = phi.norm();
+  if (a == 0) return Eigen::Quaternion<Real>::Identity();
+  return Eigen::Quaternion<Real>(Eigen::AngleAxis<Real>(a, phi / a));
+}
+/// The rotation vector of a unit quaternion (angle in [0, pi]).
+inline Vec<3> rotation_vector(const Eigen::Quaternion<Real>& q) {
+  const Eigen::AngleAxis<Real> aa(q);
+  return aa.angle() * aa.axis();
+}
+/// J_l(phi)^{-1}, the inverse left Jacobian of SO(3): if R(t) = exp([phi(t)]) R_0 turns at the
+/// angular velocity w (world axes, R' R^T = [w]_x), then phi' = J_l(phi)^{-1} w.
+inline Mat<3> so3_left_jacobian_inverse(const Vec<3>& phi) {
+  const Real a = phi.norm();
+  const Real c = a < 1e-4 ? 1.0 / 12 + a * a / 720 : 1 / (a * a) - (1 + std::cos(a)) / (2 * a * std::sin(a));
+  const Mat<3> P = skew(phi);
+  return Mat<3>::Identity() - 0.5 * P + c * P * P;
+}
+
+/// What differs between 2D and 3D rigid bodies, for sim/ale_flow.hpp: the body type, the number
+/// of rigid DOFs, H, the orientation and its update, the inertia term and its Jacobian.
+template <int D>
+struct RigidBodyTraits;
+
+template <>
+struct RigidBodyTraits<2> {
+  using Body = RigidBody2D;
+  static constexpr int n_dof = 3;
+  using Velocity = Vec<3>;
+  using Orientation = Real;  ///< the angle theta
+  static Orientation initial_orientation(const Body& b) { return b.angle; }
+  /// A surface offset at t0 as stored (world axes at the initial angle).
+  static Vec<2> initial_offset(const Vec<2>& r, const Body&) { return r; }
+  static Vec<2> to_world(const Vec<2>& r0, Orientation th, const Body& b) { return rotate(r0, th - b.angle); }
+  static Vec<2> to_body(const Vec<2>& r, Orientation th, const Body& b) { return rotate(r, -(th - b.angle)); }
+  static std::array<Velocity, 2> rows(const Vec<2>& r) { return rigid_rows(r); }
+  static Vec<2> velocity(const Velocity& Z, const Vec<2>& r) { return rigid_velocity(Z, r); }
+  /// theta^{n-1} = theta^n - dt w (the first MR/AB step).
+  static Orientation step_back(Orientation th, const Velocity& Z, Real dt) { return th - dt * Z[2]; }
+  /// The position formula sum_{k=0}^{l} b_k theta^{n+1-k} = dt w^ (past levels th[k - 1]).
+  static Orientation advance(const std::array<Orientation, 3>& th, const Velocity& Zhat, const std::array<Real, 4>& b,
+                             int l, Real dt) {
+    Real ts = dt * Zhat[2];
+    for (int k = 1; k <= l; ++k) ts -= b[k] * th[k - 1];
+    return ts / b[0];
+  }
+  /// M dZ / dt with M = diag(m, m, I33); dZ = delta_l Z (BDF combination, a0 Z + history).
+  static Velocity inertia(const Body& b, Orientation, const Velocity&, const Velocity& dZ, Real dt) {
+    return Vec<3>(b.mass, b.mass, b.inertia).cwiseProduct(dZ) / dt;
+  }
+  /// d inertia / d Z (dZ = a0 Z + history).
+  static Mat<3> inertia_jacobian(const Body& b, Orientation, const Velocity&, Real a0, Real dt) {
+    const Vec<3> m(b.mass, b.mass, b.inertia);
+    Mat<3> J = Mat<3>::Zero();
+    for (int C = 0; C < 3; ++C) J(C, C) = m[C] * a0 / dt;
+    return J;
+  }
+};
+
+template <>
+struct RigidBodyTraits<3> {
+  using Body = RigidBody3D;
+  static constexpr int n_dof = 6;
+  using Velocity = Vec<6>;
+  using Orientation = Eigen::Quaternion<Real>;  ///< unit, body frame -> world
+  static Orientation initial_orientation(const Body& b) { return b.orientation; }
+  /// A surface offset at t0, stored in the body frame.
+  static Vec<3> initial_offset(const Vec<3>& r, const Body& b) { return b.orientation.conjugate() * r; }
+  static Vec<3> to_world(const Vec<3>& rb, const Orientation& q, const Body&) { return q * rb; }
+  static Vec<3> to_body(const Vec<3>& r, const Orientation& q, const Body&) { return q.conjugate() * r; }
+  static std::array<Velocity, 3> rows(const Vec<3>& r) { return rigid_rows(r); }
+  static Vec<3> velocity(const Velocity& Z, const Vec<3>& r) { return rigid_velocity(Z, r); }
+  /// q^{n-1} = exp(-dt w) q^n (the first MR/AB step).
+  static Orientation step_back(const Orientation& q, const Velocity& Z, Real dt) {
+    return (rotation_quaternion(-dt * Vec<3>(Z.tail<3>())) * q).normalized();
+  }
+  /// The position formula applied to the rotation vector relative to q^n: with
+  /// q^{n+1-k} = exp(phi_k) q^n (phi_1 = 0), sum_k b_k phi_k = dt phi'(t^{n+1}) where
+  /// phi' = J_l(phi)^{-1} w^ (so3_left_jacobian_inverse); solved for phi_0 by fixed-point
+  /// iteration (contraction factor O(dt |w|)), then q^{n+1} = exp(phi_0) q^n, normalised.
+  /// This is the BDF formula of the centre in exponential coordinates, so the orientation has
+  /// the order of the scheme's position formula.
+  static Orientation advance(const std::array<Orientation, 3>& q, const Velocity& Zhat, const std::array<Real, 4>& b,
+                             int l, Real dt) {
+    const Vec<3> w = Zhat.tail<3>();
+    Vec<3> hist = Vec<3>::Zero();  // sum_{k >= 2} b_k phi_k
+    for (int k = 2; k <= l; ++k) hist += b[k] * rotation_vector(q[k - 1] * q[0].conjugate());
+    Vec<3> phi = (dt * w - hist) / b[0];
+    for (int it = 0; it < 50; ++it) {
+      const Vec<3> next = (dt * (so3_left_jacobian_inverse(phi) * w) - hist) / b[0];
+      const Real change = (next - phi).norm();
+      phi = next;
+      if (change <= 1e-15 * (1 + phi.norm())) break;
+    }
+    return (rotation_quaternion(phi) * q[0]).normalized();
+  }
+  /// (m dV / dt, I_w dw / dt + w x (I_w w)) with I_w = R(q) I_body R(q)^T at orientation q;
+  /// dZ = delta_l Z (BDF combination, a0 Z + history), Z = (V, w) the new velocity.
+  static Velocity inertia(const Body& b, const Orientation& q, const Velocity& Z, const Velocity& dZ, Real dt) {
+    const Mat<3> R = q.toRotationMatrix();
+    const Mat<3> Iw = R * b.inertia * R.transpose();
+    const Vec<3> w = Z.tail<3>();
+    Velocity out;
+    out.head<3>() = b.mass * dZ.head<3>() / dt;
+    out.tail<3>() = Iw * dZ.tail<3>() / dt + w.cross(Iw * w);
+    return out;
+  }
+  /// d inertia / d Z: diag(m a0 / dt) and I_w a0 / dt + [w]_x I_w - [I_w w]_x.
+  static Mat<6> inertia_jacobian(const Body& b, const Orientation& q, const Velocity& Z, Real a0, Real dt) {
+    const Mat<3> R = q.toRotationMatrix();
+    const Mat<3> Iw = R * b.inertia * R.transpose();
+    const Vec<3> w = Z.tail<3>();
+    Mat<6> J = Mat<6>::Zero();
+    for (int C = 0; C < 3; ++C) J(C, C) = b.mass * a0 / dt;
+    J.bottomRightCorner<3, 3>() = Iw * a0 / dt + skew(w) * Iw - skew(Iw * w);
+    return J;
+  }
+};
 
 }  // namespace alefsi

@@ -20,6 +20,15 @@
 /// different from the previous one restarts the history from the current state (as at t0:
 /// MR/AB start-up steps); a rejected step (exception) leaves the state at t^n untouched.
 ///
+/// Rigid bodies (`add_body`): 2D (RigidBody2D, 3 DOF) and 3D (RigidBody3D, 6 DOF, orientation a
+/// unit quaternion), coupled monolithically: a free body's velocities are extra unknowns, its
+/// surface velocity DOFs are linked to them through H (at X^{n+1}), its rows are the
+/// Newton-Euler equations (3D: with the gyroscopic term w x I_w w and its exact Jacobian).
+/// Centre and orientation advance by the scheme's position formula with the extrapolated body
+/// velocity (3D: on the rotation vector relative to q^n, see RigidBodyTraits<3>::advance);
+/// surface nodes follow the exact rigid map. What differs between 2D and 3D is
+/// RigidBodyTraits<D> (physics/rigid_body.hpp).
+///
 /// Remeshing (2D, `set_remeshing`): after each step, if the worst cell quality is below the
 /// trigger or an edge leaves the size band, the mesh is adapted (mesh/adapt/adapt2d.hpp;
 /// disks stay on their exact circles, other bodies' surfaces are kept), every history level
@@ -159,6 +168,12 @@ class AleFlow {
   using Space = MixedSpace<D, Pair>;
   using Kernel = AleNavierStokesKernel<D, Pair, Convection>;
   using TimeFunction = std::function<Vec<D>(const Vec<D>&, Real)>;
+  /// What differs between 2D and 3D bodies (physics/rigid_body.hpp).
+  using BodyTraits = RigidBodyTraits<D>;
+  using BodyData = typename BodyTraits::Body;                 ///< RigidBody2D / RigidBody3D
+  using BodyVelocity = typename BodyTraits::Velocity;         ///< Z: Vec<3> (2D) / Vec<6> (3D)
+  using BodyOrientation = typename BodyTraits::Orientation;  ///< angle (2D) / unit quaternion (3D)
+  static constexpr int body_dofs = BodyTraits::n_dof;
 
   AleFlow(Mesh<D> mesh, FlowOptions opt) : mesh_(std::move(mesh)), opt_(opt) {
     ALEFSI_CHECK_ARG(opt.rho >= 0 && std::isfinite(opt.rho), "rho", "fluid density must be >= 0 and finite, got ", opt.rho);
@@ -195,31 +210,44 @@ class AleFlow {
   void set_prescribed_mesh_velocity(TimeFunction v) { prescribed_ = std::move(v); }
   /// Gravity: body force rho_f g on the fluid and M g on every free body.
   void set_gravity(const Vec<D>& g) { gravity_ = g; }
-  /// Adds a rigid body (2D). Its surface facets carry `body.tag`; returns its index.
+  /// Adds a rigid body (2D: 3 DOF). Its surface facets carry `body.tag`; returns its index.
   std::size_t add_body(const RigidBody2D& body)
-    requires(D == 2)  // 3D bodies (6 DOF, quaternions) are not implemented yet
+    requires(D == 2)
   {
-    require_not_started("add_body");
-    body.validate(bodies_.size());
-    ALEFSI_CHECK_ARG(!mesh_.boundary_nodes(body.tag).empty(), "body.tag", "no boundary facet has tag ", body.tag);
-    ALEFSI_CHECK_ARG(!dirichlet_.count(body.tag), "body.tag", "tag ", body.tag, " already has a Dirichlet velocity");
-    Body b;
-    b.data = body;
-    b.xg.fill(body.centre);
-    b.th.fill(body.angle);
-    b.Z.fill(body.prescribed ? body.prescribed(t_) : body.velocity);
-    b.nodes = mesh_.boundary_nodes(body.tag);
-    for (Index v : b.nodes) b.r0.push_back(mesh_.node(v) - body.centre);
-    bodies_.push_back(std::move(b));
-    return bodies_.size() - 1;
+    return add_body_impl(body);
   }
-  /// Body k's centre of mass, angle and velocity Z = (V1, V2, w3) at t^n.
+  /// Adds a rigid body (3D: 6 DOF, orientation a unit quaternion). Its surface facets carry
+  /// `body.tag`; returns its index.
+  std::size_t add_body(const RigidBody3D& body)
+    requires(D == 3)
+  {
+    return add_body_impl(body);
+  }
+  /// Body k's centre of mass and velocity Z at t^n: (V1, V2, w3) in 2D, (V, w) in 3D.
   Vec<D> body_centre(std::size_t k) const { return bodies_.at(k).xg[0]; }
-  Real body_angle(std::size_t k) const { return bodies_.at(k).th[0]; }
-  Vec<3> body_velocity(std::size_t k) const { return bodies_.at(k).Z[0]; }
-  /// Hydrodynamic force and torque (F1, F2, T3) on free body k over the last step, from its
-  /// momentum balance: M delta_l Z / dt - M g - external load - collision force.
-  Vec<3> body_hydrodynamic_load(std::size_t k) const { return bodies_.at(k).load; }
+  BodyVelocity body_velocity(std::size_t k) const { return bodies_.at(k).Z[0]; }
+  /// Body k's angle at t^n (2D).
+  Real body_angle(std::size_t k) const
+    requires(D == 2)
+  {
+    return bodies_.at(k).th[0];
+  }
+  /// Body k's orientation at t^n (3D): the unit quaternion mapping body axes to world axes.
+  Eigen::Quaternion<Real> body_orientation(std::size_t k) const
+    requires(D == 3)
+  {
+    return bodies_.at(k).th[0];
+  }
+  /// Surface node positions of body k at t^n (from the exact rigid map).
+  std::vector<Vec<D>> body_surface(std::size_t k) const {
+    std::vector<Vec<D>> x;
+    for (Index v : bodies_.at(k).nodes) x.push_back(X_[0][v]);
+    return x;
+  }
+  /// Hydrodynamic force and torque on free body k over the last step, (F1, F2, T3) in 2D,
+  /// (F, T) in 3D (torque about the centre of mass, world axes), from its momentum balance:
+  /// M delta_l Z / dt (+ w x I_w w in 3D) - M g - external load - collision force.
+  BodyVelocity body_hydrodynamic_load(std::size_t k) const { return bodies_.at(k).load; }
   void set_force(TimeFunction f) { force_ = std::move(f); }
   void set_initial_velocity(const std::function<Vec<D>(const Vec<D>&)>& u0, Real t0 = 0) {
     require_not_started("set_initial_velocity");
@@ -392,10 +420,10 @@ class AleFlow {
       w.put(std::int32_t(b.data.tag));
       for (int k = 0; k < 3; ++k) {
         w.put_vector(std::vector<Real>(b.xg[k].data(), b.xg[k].data() + D));
-        w.put(b.th[k]);
-        w.put_vector(std::vector<Real>(b.Z[k].data(), b.Z[k].data() + 3));
+        put_orientation(w, b.th[k]);
+        w.put_vector(std::vector<Real>(b.Z[k].data(), b.Z[k].data() + body_dofs));
       }
-      w.put_vector(std::vector<Real>(b.load.data(), b.load.data() + 3));
+      w.put_vector(std::vector<Real>(b.load.data(), b.load.data() + body_dofs));
       w.put_vector(std::vector<Real>(b.contact.data(), b.contact.data() + D));
       w.put_vector(flatten(b.r0));
     }
@@ -436,18 +464,19 @@ class AleFlow {
       if (r.get<std::int32_t>("body tag") != b.data.tag) r.fail("body tags differ from this flow's");
       for (int k = 0; k < 3; ++k) {
         const auto xg = r.get_vector<Real>("body centre");
-        const Real th = r.get<Real>("body angle");
+        const BodyOrientation th = get_orientation(r);
         const auto Z = r.get_vector<Real>("body velocity");
-        if (xg.size() != std::size_t(D) || Z.size() != 3) r.fail("bad body record");
+        if (xg.size() != std::size_t(D) || Z.size() != std::size_t(body_dofs)) r.fail("bad body record");
         for (int c = 0; c < D; ++c) b.xg[k][c] = xg[c];
         b.th[k] = th;
-        for (int c = 0; c < 3; ++c) b.Z[k][c] = Z[c];
+        for (int c = 0; c < body_dofs; ++c) b.Z[k][c] = Z[c];
       }
       const auto load = r.get_vector<Real>("body load");
       const auto contact = r.get_vector<Real>("body contact");
       b.r0 = unflatten(r.get_vector<Real>("body surface"));
-      if (load.size() != 3 || contact.size() != std::size_t(D) || b.r0.size() != b.nodes.size()) r.fail("bad body record");
-      for (int c = 0; c < 3; ++c) b.load[c] = load[c];
+      if (load.size() != std::size_t(body_dofs) || contact.size() != std::size_t(D) || b.r0.size() != b.nodes.size())
+        r.fail("bad body record");
+      for (int c = 0; c < body_dofs; ++c) b.load[c] = load[c];
       for (int c = 0; c < D; ++c) b.contact[c] = contact[c];
     }
     r.section("end");
@@ -463,6 +492,37 @@ class AleFlow {
   }
 
  private:
+  // A body's orientation in a checkpoint: the angle (2D), the quaternion (x, y, z, w) (3D).
+  static void put_orientation(CheckpointWriter& w, const BodyOrientation& th) {
+    if constexpr (D == 2) w.put(th);
+    else w.put_vector(std::vector<Real>(th.coeffs().data(), th.coeffs().data() + 4));
+  }
+  static BodyOrientation get_orientation(CheckpointReader& r) {
+    if constexpr (D == 2) {
+      return r.get<Real>("body angle");
+    } else {
+      const auto q = r.get_vector<Real>("body orientation");
+      if (q.size() != 4) r.fail("bad body record");
+      return Eigen::Quaternion<Real>(q[3], q[0], q[1], q[2]);
+    }
+  }
+
+  std::size_t add_body_impl(const BodyData& body) {
+    require_not_started("add_body");
+    body.validate(bodies_.size());
+    ALEFSI_CHECK_ARG(!mesh_.boundary_nodes(body.tag).empty(), "body.tag", "no boundary facet has tag ", body.tag);
+    ALEFSI_CHECK_ARG(!dirichlet_.count(body.tag), "body.tag", "tag ", body.tag, " already has a Dirichlet velocity");
+    Body b;
+    b.data = body;
+    b.xg.fill(body.centre);
+    b.th.fill(BodyTraits::initial_orientation(body));
+    b.Z.fill(body.prescribed ? body.prescribed(t_) : body.velocity);
+    b.nodes = mesh_.boundary_nodes(body.tag);
+    for (Index v : b.nodes) b.r0.push_back(BodyTraits::initial_offset(mesh_.node(v) - body.centre, body));
+    bodies_.push_back(std::move(b));
+    return bodies_.size() - 1;
+  }
+
   void require_not_started(const char* what) const {
     if (cons_) throw Error(std::string("AleFlow::") + what + " after the first step");
   }
@@ -472,26 +532,26 @@ class AleFlow {
     const auto& vel = space_->velocity();
     std::vector<char> done(vel.n_dofs(), 0);
     dirichlet_dofs_ = fix_velocity_on_tags(*space_, dirichlet_, *cons_, done);
-    if constexpr (D == 2)
-      for (auto& b : bodies_) {
-        b.dofs.clear();
-        if (b.data.free()) b.extra = cons_->add_unknowns(3);
-        for (Index i : vel.boundary_dofs(b.data.tag)) {
-          ALEFSI_CHECK_ARG(!done[i], "body.tag", "body surface (tag ", b.data.tag, ") touches a Dirichlet wall or another body");
-          done[i] = 1;
-          b.dofs.push_back(i);
-          for (int k = 0; k < D; ++k) {
-            const Index f = space_->velocity_field(i, k);
-            if (b.data.free()) {
-              const Index ex[] = {b.extra, b.extra + 1, b.extra + 2};
-              const Real w[] = {0.0, 0.0, 0.0};
-              cons_->link(f, ex, w, 0.0);
-            } else {
-              cons_->fix(f, 0.0);
-            }
+    for (auto& b : bodies_) {
+      b.dofs.clear();
+      if (b.data.free()) b.extra = cons_->add_unknowns(body_dofs);
+      for (Index i : vel.boundary_dofs(b.data.tag)) {
+        ALEFSI_CHECK_ARG(!done[i], "body.tag", "body surface (tag ", b.data.tag, ") touches a Dirichlet wall or another body");
+        done[i] = 1;
+        b.dofs.push_back(i);
+        for (int k = 0; k < D; ++k) {
+          const Index f = space_->velocity_field(i, k);
+          if (b.data.free()) {
+            std::array<Index, body_dofs> ex;
+            for (int C = 0; C < body_dofs; ++C) ex[C] = b.extra + C;
+            const std::array<Real, body_dofs> w{};
+            cons_->link(f, ex, w, 0.0);
+          } else {
+            cons_->fix(f, 0.0);
           }
         }
       }
+    }
     // every boundary velocity prescribed (walls or bodies): p is defined up to a constant
     pinned_ = whole_boundary_prescribed(mesh_, [&](int tag) {
       bool body = false;
@@ -502,16 +562,17 @@ class AleFlow {
     cons_->finalize();
     asmb_ = std::make_unique<Assembler<Space::n_local>>(
         mesh_.n_cells(), [&](Index c) { return space_->cell_field_dofs(c); }, *cons_);
+    for (const auto& b : bodies_)  // disks and spheres: their surface is on the given radius
+      if (b.data.radius > 0)
+        for (Index v : b.nodes)
+          ALEFSI_CHECK_ARG(std::abs((mesh_.node(v) - b.xg[0]).norm() - b.data.radius) <= 1e-6 * b.data.radius,
+                           "body.radius", "body with tag ", b.data.tag, ": surface node ", v, " is at distance ",
+                           (mesh_.node(v) - b.xg[0]).norm(), " from the centre, not the radius ", b.data.radius);
     if constexpr (D == 2) {
       for (auto& b : bodies_) {
         b.facets.clear();
         for (Index f : mesh_.boundary_facets())
           if (mesh_.facet_tag(f) == b.data.tag) b.facets.push_back({mesh_.facet(f)[0], mesh_.facet(f)[1]});
-        if (b.data.radius > 0)
-          for (Index v : b.nodes)
-            ALEFSI_CHECK_ARG(std::abs((mesh_.node(v) - b.xg[0]).norm() - b.data.radius) <= 1e-6 * b.data.radius,
-                             "body.radius", "body with tag ", b.data.tag, ": surface node ", v, " is at distance ",
-                             (mesh_.node(v) - b.xg[0]).norm(), " from the centre, not the radius ", b.data.radius);
       }
       update_collision_walls();
       // a scene with overlapping bodies is refused before the first step (the mesh cannot
@@ -634,20 +695,18 @@ class AleFlow {
   // Rigid velocities of the body nodes on geometry x for the mesh-velocity problem: the bodies'
   // extrapolated state (weights w over levels n, n-1, n-2), or the prescribed motion at t.
   void set_body_mesh_velocity(const std::vector<Vec<D>>& x, const std::array<Real, 3>& w, Real t) {
-    if constexpr (D == 2) {
-      if (bodies_.empty()) return;
-      body_v_.assign(mesh_.n_nodes(), Vec<D>::Zero());
-      body_has_v_.assign(mesh_.n_nodes(), 0);
-      for (auto& b : bodies_) {
-        Vec<2> xg = Vec<2>::Zero();
-        Vec<3> Z = Vec<3>::Zero();
-        for (int k = 0; k < 3; ++k) xg += w[k] * b.xg[k], Z += w[k] * b.Z[k];
-        if (!b.data.free()) Z = b.data.prescribed(t);
-        b.Zhat = Z;
-        for (Index v : b.nodes) {
-          body_v_[v] = rigid_velocity(Z, x[v] - xg);
-          body_has_v_[v] = 1;
-        }
+    if (bodies_.empty()) return;
+    body_v_.assign(mesh_.n_nodes(), Vec<D>::Zero());
+    body_has_v_.assign(mesh_.n_nodes(), 0);
+    for (auto& b : bodies_) {
+      Vec<D> xg = Vec<D>::Zero();
+      BodyVelocity Z = BodyVelocity::Zero();
+      for (int k = 0; k < 3; ++k) xg += w[k] * b.xg[k], Z += w[k] * b.Z[k];
+      if (!b.data.free()) Z = b.data.prescribed(t);
+      b.Zhat = Z;
+      for (Index v : b.nodes) {
+        body_v_[v] = BodyTraits::velocity(Z, x[v] - xg);
+        body_has_v_[v] = 1;
       }
     }
   }
@@ -662,7 +721,7 @@ class AleFlow {
       U_[1] = U_[0];
       for (auto& b : bodies_) {
         b.xg[1] = b.xg[0] - dt * b.Z[0].template head<D>();
-        b.th[1] = b.th[0] - dt * b.Z[0][2];
+        b.th[1] = BodyTraits::step_back(b.th[0], b.Z[0], dt);
         b.Z[1] = b.Z[0];
       }
     }
@@ -694,18 +753,17 @@ class AleFlow {
       for (int k = 1; k <= S::position_bdf; ++k) s -= b[k] * X_[k - 1][i];
       Xn1[i] = s / b[0];
     }
-    // bodies: centre and angle by the same formula with the extrapolated rigid velocity;
-    // their surface nodes are placed by the exact rigid motion
-    if constexpr (D == 2)
-      for (auto& body : bodies_) {
-        Vec<D> xs = dt * body.Zhat.template head<D>();
-        Real ts = dt * body.Zhat[2];
-        for (int k = 1; k <= S::position_bdf; ++k) xs -= b[k] * body.xg[k - 1], ts -= b[k] * body.th[k - 1];
-        body.xg_next = xs / b[0];
-        body.th_next = ts / b[0];
-        for (std::size_t j = 0; j < body.nodes.size(); ++j)
-          Xn1[body.nodes[j]] = body.xg_next + rotate(body.r0[j], body.th_next - body.data.angle);
-      }
+    // bodies: centre and orientation by the same formula with the extrapolated rigid velocity
+    // (3D: on the rotation vector, RigidBodyTraits<3>::advance); their surface nodes are
+    // placed by the exact rigid motion
+    for (auto& body : bodies_) {
+      Vec<D> xs = dt * body.Zhat.template head<D>();
+      for (int k = 1; k <= S::position_bdf; ++k) xs -= b[k] * body.xg[k - 1];
+      body.xg_next = xs / b[0];
+      body.th_next = BodyTraits::advance(body.th, body.Zhat, b, S::position_bdf, dt);
+      for (std::size_t j = 0; j < body.nodes.size(); ++j)
+        Xn1[body.nodes[j]] = body.xg_next + BodyTraits::to_world(body.r0[j], body.th_next, body.data);
+    }
     // mesh velocity the flow sees, and V^{n+1} for the next step
     std::vector<Vec<D>> Vflow = Vs, Vnext = Vs;
     if (S::velocity_level == VelocityLevel::n_half)
@@ -722,21 +780,21 @@ class AleFlow {
       for (int k = 0; k < D; ++k) cons_->set_fixed_value(space_->velocity_field(i, k), val[k]);
     }
     // body surface velocities at t^{n+1} on X^{n+1}: u = H Z + u_s
-    if constexpr (D == 2)
-      for (auto& body : bodies_) {
-        const Real rot = body.th_next - body.data.angle;
-        const Vec<3> Zp = body.data.free() ? Vec<3>::Zero() : body.data.prescribed(t1);
-        for (Index i : body.dofs) {
-          const Vec<2> r = dof_point(i, Xn1) - body.xg_next;
-          const Vec<2> us = body.data.slip ? rotate(body.data.slip(rotate(r, -rot)), rot) : Vec<2>::Zero();
-          const auto H = rigid_rows(r);
-          for (int k = 0; k < 2; ++k) {
-            const Index f = space_->velocity_field(i, k);
-            if (body.data.free()) cons_->set_link(f, {H[k].data(), 3}, us[k]);
-            else cons_->set_fixed_value(f, H[k].dot(Zp) + us[k]);
-          }
+    for (auto& body : bodies_) {
+      const BodyVelocity Zp = body.data.free() ? BodyVelocity::Zero() : BodyVelocity(body.data.prescribed(t1));
+      for (Index i : body.dofs) {
+        const Vec<D> r = dof_point(i, Xn1) - body.xg_next;
+        const Vec<D> us = body.data.slip ? BodyTraits::to_world(body.data.slip(BodyTraits::to_body(r, body.th_next, body.data)),
+                                                                body.th_next, body.data)
+                                         : Vec<D>::Zero();
+        const auto H = BodyTraits::rows(r);
+        for (int k = 0; k < D; ++k) {
+          const Index f = space_->velocity_field(i, k);
+          if (body.data.free()) cons_->set_link(f, {H[k].data(), std::size_t(body_dofs)}, us[k]);
+          else cons_->set_fixed_value(f, H[k].dot(Zp) + us[k]);
         }
       }
+    }
     // history of the BDF time derivative and the extrapolated convecting velocity
     const auto a = bdf_coefficients(S::flow_bdf);
     VecX hist = VecX::Zero(U_[0].size());
@@ -776,7 +834,7 @@ class AleFlow {
     clock = std::chrono::steady_clock::now();
     VecX u = cons_->restrict_free(U_[0]);
     for (const auto& body : bodies_)
-      if (body.data.free()) u.template segment<3>(cons_->extra_unknown(body.extra)) = body.Z[0];
+      if (body.data.free()) u.template segment<body_dofs>(cons_->extra_unknown(body.extra)) = body.Z[0];
     VecX field = cons_->expand(u);
     VecX r;
     Real r0 = -1;
@@ -812,7 +870,8 @@ class AleFlow {
     }
     if (pinned_) shift_pressure_to_zero_mean(*space_, field);
     for (auto& body : bodies_) {
-      const Vec<3> Zn1 = body.data.free() ? Vec<3>(u.template segment<3>(cons_->extra_unknown(body.extra))) : body.data.prescribed(t1);
+      const BodyVelocity Zn1 = body.data.free() ? BodyVelocity(u.template segment<body_dofs>(cons_->extra_unknown(body.extra)))
+                                                : BodyVelocity(body.data.prescribed(t1));
       if (body.data.free()) {
         body.load = body_inertia<S>(body, Zn1, dt) - body_weight(body) - body.data_external();
         body.load.template head<D>() -= body.contact;
@@ -836,36 +895,37 @@ class AleFlow {
   }
 
   struct Body {
-    RigidBody2D data;
+    BodyData data;
     std::array<Vec<D>, 3> xg;
-    std::array<Real, 3> th{};
-    std::array<Vec<3>, 3> Z;
-    Vec<3> Zhat = Vec<3>::Zero(), load = Vec<3>::Zero();
+    std::array<BodyOrientation, 3> th{};  // angle (2D) / quaternion (3D) per level
+    std::array<BodyVelocity, 3> Z;
+    BodyVelocity Zhat = BodyVelocity::Zero(), load = BodyVelocity::Zero();
     Vec<D> xg_next = Vec<D>::Zero();
-    Real th_next = 0;
-    Index extra = -1;           // first of its 3 extra unknowns (free bodies)
+    BodyOrientation th_next{};
+    Index extra = -1;           // first of its body_dofs extra unknowns (free bodies)
     std::vector<Index> nodes;   // surface mesh nodes
-    std::vector<Vec<D>> r0;     // their offsets from the centre at t0
+    std::vector<Vec<D>> r0;     // their offsets from the centre at t0 (3D: in body axes)
     std::vector<Index> dofs;    // surface velocity DOFs
     std::vector<std::array<Index, 2>> facets;  // surface facets (2D)
     Vec<D> contact = Vec<D>::Zero();           // collision force in the last step
-    Vec<3> data_external() const { return data.external_load; }
+    BodyVelocity data_external() const { return data.external_load; }
   };
 
-  // M delta_l Z^{n+1} / dt for body b.
+  // M delta_l Z^{n+1} / dt (+ w x I_w w in 3D) for body b, at its orientation for t^{n+1}.
   template <TimeScheme S>
-  static Vec<3> body_inertia(const Body& b, const Vec<3>& Zn1, Real dt) {
+  static BodyVelocity body_inertia(const Body& b, const BodyVelocity& Zn1, Real dt) {
     const auto a = bdf_coefficients(S::flow_bdf);
-    Vec<3> dZ = a[0] * Zn1;
+    BodyVelocity dZ = a[0] * Zn1;
     for (int k = 1; k <= S::flow_bdf; ++k) dZ += a[k] * b.Z[k - 1];
-    return Vec<3>(b.data.mass, b.data.mass, b.data.inertia).cwiseProduct(dZ) / dt;
+    return BodyTraits::inertia(b.data, b.th_next, Zn1, dZ, dt);
   }
-  Vec<3> body_weight(const Body& b) const {
-    Vec<3> w = Vec<3>::Zero();
+  BodyVelocity body_weight(const Body& b) const {
+    BodyVelocity w = BodyVelocity::Zero();
     w.template head<D>() = b.data.mass * gravity_;
     return w;
   }
-  // Body rows (eq. 11): M delta_l Z / dt - M g - external load, added to the fluid terms.
+  // Body rows (eq. 11): M delta_l Z / dt (+ w x I_w w) - M g - external load, added to the
+  // fluid terms; their Jacobian (exact, gyroscopic term included) on the body's block.
   template <TimeScheme S>
   void add_body_rows(Real dt, const VecX& u, VecX& r) {
     const Real a0 = bdf_coefficients(S::flow_bdf)[0];
@@ -873,10 +933,12 @@ class AleFlow {
       body.contact = Vec<D>::Zero();
       if (!body.data.free()) continue;
       const Index e = cons_->extra_unknown(body.extra);
-      const Vec<3> Z = u.template segment<3>(e);
-      r.template segment<3>(e) += body_inertia<S>(body, Z, dt) - body_weight(body) - body.data_external();
-      const Vec<3> m(body.data.mass, body.data.mass, body.data.inertia);
-      for (int C = 0; C < 3; ++C) J_.coeffRef(e + C, e + C) += m[C] * a0 / dt;
+      const BodyVelocity Z = u.template segment<body_dofs>(e);
+      r.template segment<body_dofs>(e) += body_inertia<S>(body, Z, dt) - body_weight(body) - body.data_external();
+      const auto Jb = BodyTraits::inertia_jacobian(body.data, body.th_next, Z, a0, dt);
+      for (int i = 0; i < body_dofs; ++i)
+        for (int j = 0; j < body_dofs; ++j)
+          if (Jb(i, j) != 0) J_.coeffRef(e + i, e + j) += Jb(i, j);  // structural zeros stay untouched
     }
     if constexpr (D == 2) {
       if (contacts_.empty()) return;

@@ -158,7 +158,7 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
   };
   while (flow.time() < opt.t_end - 1e-12 * opt.dt) {
     const Real h = std::min(dt, opt.t_end - flow.time());
-    StepReport rep;
+    decltype(flow.step(Real(1))) rep{};
     int tries = 0;
     Real h_try = h;
     for (;;) {

@@ -48,10 +48,6 @@
 #include <string>
 #include <vector>
 
-#ifdef ALEFSI_ANNULUS_UMFPACK
-#include <Eigen/UmfPackSupport>
-#endif
-
 using namespace alefsi;
 using std::numbers::pi;
 using Clock = std::chrono::steady_clock;
@@ -60,29 +56,11 @@ namespace {
 
 // --- the linear solver ---------------------------------------------------------------------------
 // The sweeps factorise Taylor-Hood saddle-point matrices of 2e4-1e5 unknowns thousands of times:
-// Eigen's SparseLU (COLAMD) takes ~3 s for 3.5e4 unknowns on this machine, UMFPACK with its
-// symmetric strategy 0.35 s. examples/CMakeLists.txt defines ALEFSI_ANNULUS_UMFPACK when it
-// finds libumfpack; otherwise the library's default SparseLu is used (same results, slower).
-#ifdef ALEFSI_ANNULUS_UMFPACK
-class Umfpack {
- public:
-  static constexpr const char* name = "UMFPACK (symmetric strategy)";
-  Umfpack() { lu_.umfpackControl()(UMFPACK_STRATEGY) = UMFPACK_STRATEGY_SYMMETRIC; }
-  void analyze(const SparseMatrix& A) { lu_.analyzePattern(A); }
-  void factorize(const SparseMatrix& A) {
-    lu_.factorize(A);
-    if (lu_.info() != Eigen::Success) throw SolverError("UMFPACK factorisation failed");
-  }
-  VecX solve(const VecX& b) {
-    VecX x = lu_.solve(b);
-    if (lu_.info() != Eigen::Success) throw SolverError("UMFPACK solve failed");
-    return x;
-  }
-
- private:
-  Eigen::UmfPackLU<SparseMatrix> lu_;
-};
-using Solver = Umfpack;
+// UMFPACK with its symmetric strategy (la/suitesparse.hpp, when alefsi was built with
+// SuiteSparse) or else the library's default SparseLU with the saddle-point AMD ordering
+// (docs/solvers.md: both within 1.5x of each other; COLAMD was 10x slower).
+#ifdef ALEFSI_HAVE_SUITESPARSE
+using Solver = UmfPackLu;
 #else
 using Solver = SparseLu<>;
 #endif

@@ -306,18 +306,18 @@ class AleFlow {
   }
   /// Collision force on body k in the last step (F1, F2).
   Vec<D> body_collision_force(std::size_t k) const { return bodies_.at(k).contact; }
-  /// Gap between body k's surface and the nearest other body or wall, at t^n (disk bodies
-  /// exactly; others from their surface facets); +inf when nothing is within reach.
-  Real body_gap(std::size_t k) const
+  /// Per body, the gap between its surface and the nearest other body or wall, at t^n (disk
+  /// bodies exactly; others from their surface facets). One search for all bodies.
+  std::vector<Real> body_gaps() const
     requires(D == 2)
   {
     CollisionModel2D model(CollisionOptions{.range = 1e6});
-    if (collision_) model.set_walls(collision_->walls());
-    else model.set_walls(wall_segments());
-    const auto bodies = collision_bodies(0);
-    Real g = std::numeric_limits<Real>::infinity();
-    for (const auto& c : model.contacts(bodies, opt_.mu))
-      if (c.k == int(k) || c.j == int(k)) g = std::min(g, c.gap);
+    model.set_walls(collision_ ? collision_->walls() : wall_segments());
+    std::vector<Real> g(bodies_.size(), std::numeric_limits<Real>::infinity());
+    for (const auto& c : model.contacts(collision_bodies(0), opt_.mu)) {
+      g[c.k] = std::min(g[c.k], c.gap);
+      if (c.j >= 0) g[c.j] = std::min(g[c.j], c.gap);
+    }
     return g;
   }
 
@@ -328,9 +328,7 @@ class AleFlow {
   {
     ALEFSI_CHECK_ARG(remesh_.has_value(), "remesh", "call set_remeshing first");
     std::vector<BoundaryCurve> curves = remesh_->walls;
-    std::vector<Circle> disks;
-    for (const auto& b : bodies_)
-      if (b.data.radius > 0) disks.push_back(Circle{b.xg[0], b.data.radius, b.data.tag});
+    const std::vector<Circle> disks = current_disks();
     curves.insert(curves.end(), disks.begin(), disks.end());
     AdaptOptions ao = remesh_->adapt;
     if (remesh_->size) ao.size = remesh_->size(disks);
@@ -640,16 +638,23 @@ class AleFlow {
     return out;
   }
 
+  // The disk bodies (radius > 0) as circles at their place at t^n.
+  std::vector<Circle> current_disks() const
+    requires(D == 2)
+  {
+    std::vector<Circle> disks;
+    for (const auto& b : bodies_)
+      if (b.data.radius > 0) disks.push_back(Circle{b.xg[0], b.data.radius, b.data.tag});
+    return disks;
+  }
+
   // (worst quality, worst relative size deviation |L - h| / h) of the current mesh
   std::pair<Real, Real> mesh_badness() const
     requires(D == 2)
   {
     Real dev = 0;
     if (remesh_->size) {
-      std::vector<Circle> disks;
-      for (const auto& b : bodies_)
-        if (b.data.radius > 0) disks.push_back(Circle{b.xg[0], b.data.radius, b.data.tag});
-      const SizeFunction h = remesh_->size(disks);
+      const SizeFunction h = remesh_->size(current_disks());
       for (const auto& e : mesh_.edges()) {
         const Vec<2> a = mesh_.node(e[0]), c = mesh_.node(e[1]);
         const Real E = h(0.5 * (a + c));

@@ -187,9 +187,9 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
     sum.t_factorize += rep.t_factorize, sum.t_solve += rep.t_solve, sum.t_remesh += rep.t_remesh;
     const Real q = flow.worst_quality();
     sum.worst_quality = std::min(sum.worst_quality, q);
+    const std::vector<Real> gaps = flow.body_gaps();
     Real gap_min = std::numeric_limits<Real>::infinity();
-    std::vector<Real> gaps(nb);
-    for (std::size_t k = 0; k < nb; ++k) gap_min = std::min(gap_min, gaps[k] = flow.body_gap(k));
+    for (Real g : gaps) gap_min = std::min(gap_min, g);
     sum.min_gap = std::min(sum.min_gap, gap_min);
     if (csv.is_open()) {
       csv << flow.time() << ',' << h_try << ',' << rep.newton_iterations << ',' << int(rep.remeshed) << ',' << q;

@@ -27,6 +27,7 @@
 
 #include "alefsi/core/types.hpp"
 #include "alefsi/fem/concepts.hpp"
+#include "alefsi/fem/lagrange.hpp"
 #include "alefsi/fem/quadrature.hpp"
 
 namespace alefsi {
@@ -121,12 +122,7 @@ class AffineStokesForms {
   /// A(D nv + b, D a + i) += s_pv int_K psi_b d_i phi_a   (the (q, div u) block).
   /// 2 D^2 nv np flops for the contraction, 4 D nv np for the two updates.
   void add_divergence(const Mat<D>& Jinv, Real detJ, Real s_vp, Real s_pv, LocalMat& A) const {
-    std::array<VpArray, D> dv;  // dv[i][a np + b] = int_K psi_b d_i phi_a
-    for (int i = 0; i < D; ++i) {
-      VpArray t = E_[0] * (detJ * Jinv(0, i));
-      for (int m = 1; m < D; ++m) t += E_[m] * (detJ * Jinv(m, i));
-      dv[i] = t;
-    }
+    const auto dv = divergence(Jinv, detJ);
     for (int a = 0; a < nv; ++a)
       for (int b = 0; b < np; ++b)
         for (int i = 0; i < D; ++i) {
@@ -134,6 +130,17 @@ class AffineStokesForms {
           A(D * a + i, D * nv + b) += s_vp * v;
           A(D * nv + b, D * a + i) += s_pv * v;
         }
+  }
+
+  /// dv[i][a np + b] = int_K psi_b d_i phi_a. 2 D^2 nv np flops.
+  std::array<VpArray, D> divergence(const Mat<D>& Jinv, Real detJ) const {
+    std::array<VpArray, D> dv;
+    for (int i = 0; i < D; ++i) {
+      VpArray t = E_[0] * (detJ * Jinv(0, i));
+      for (int m = 1; m < D; ++m) t += E_[m] * (detJ * Jinv(m, i));
+      dv[i] = t;
+    }
+    return dv;
   }
 
   /// A(D nv + a, D nv + b) += s int_K grad psi_a . grad psi_b (pressure Laplacian, for PSPG):
@@ -195,6 +202,128 @@ class AffineStokesForms {
   std::array<VpArray, D> E_;        // E_[m][a np + b] = int_ref psi_b d^_m phi_a
   PairArray M_;                     // M_[p] = int_ref phi_a phi_b
   std::array<std::array<Mat<D>, np>, np> Sp_;  // Sp_[a][b](m, n) = int_ref d^_m psi_a d^_n psi_b
+};
+
+
+/// The velocity-velocity block of the Navier–Stokes Jacobian on affine simplices, from
+/// reference integrals computed once (exact rule), no quadrature per cell. Every quantity is an
+/// array over *all* velocity pairs (a, b), lane a + nv b (padded to 8 lanes), i.e. an nv x nv
+/// column-major matrix per component pair (i, j): the block is formed with whole-array
+/// operations and written into the element matrix once.
+///   gradient pairs  G_kl(a, b) = int_K d_k phi_a d_l phi_b = det J sum_mn Jinv(m,k) S_ab(m,n) Jinv(n,l)
+///   mass            M(a, b)    = int_K phi_a phi_b = det J M^_ab
+///   convection      C(a, b)    = int_K phi_a (a . grad phi_b) = sum_{c,m} T_ab(c, m) at_(c,m),
+///       T_ab(c, m) = int_ref phi^_a phi^_c d^_m phi^_b,   at_(c,m) = det J sum_j Jinv(m, j) a_c,j,
+///     for a convecting velocity a of the velocity space with nodal values a_c (the P1 mesh
+///     velocity is interpolated into it exactly, `p1_at_nodes`): nv^3 D multiply-adds.
+///   Newton term     N_ij(a, b) = int_K phi_a phi_b d_j u_i: the gradient of a velocity of
+///     degree <= 2 is linear, so it equals its P1 interpolant sum_k (d_j u_i)(x_k) psi_k and
+///     N_ij(a, b) = det J sum_k (d_j u_i)(x_k) M3_ab(k),  M3_ab(k) = int_ref phi^_a phi^_b psi^_k.
+///
+///     const auto& f = alefsi::AffineNavierStokesForms<2, alefsi::TaylorHood>::get();
+///     typename decltype(f)::Block g;  f.gradient_pairs(Jinv, detJ, g);
+///     typename decltype(f)::AbArray c; f.convection(Jinv, detJ, a_nodal, c);
+template <int D, ElementPair Pair>
+class AffineNavierStokesForms {
+ public:
+  using V = typename Pair::template Velocity<D>;
+  static constexpr int nv = V::n_dofs;
+  static constexpr int n_ab = (nv * nv + 7) / 8 * 8;  ///< all pairs (a, b), lane a + nv b, padded
+  using AbArray = Eigen::Array<Real, n_ab, 1>;
+  /// One AbArray per component pair: [i D + j].
+  using Block = std::array<AbArray, D * D>;
+  using Nodal = Eigen::Matrix<Real, nv, D>;  ///< nodal values of a vector field, row = node
+  /// The physical gradient of a velocity field at the D + 1 vertices: [k](i, j) = d_j u_i (x_k).
+  using VertexGradients = std::array<Mat<D>, D + 1>;
+
+  static const AffineNavierStokesForms& get() {
+    static const AffineNavierStokesForms forms;
+    return forms;
+  }
+
+  /// psi_k(node c) for the P1 basis psi_k at the velocity nodes (row c): the nodal values of a
+  /// P1 field with vertex values W are p1_at_nodes() * W.
+  const Eigen::Matrix<Real, nv, D + 1>& p1_at_nodes() const { return p1_nodes_; }
+  /// The reference mass integrals int_ref phi^_a phi^_b (times det J: the cell's).
+  const AbArray& reference_mass() const { return M_; }
+
+  /// out[k D + l](a, b) = int_K d_k phi_a d_l phi_b. 2 D^3 array multiply-adds.
+  void gradient_pairs(const Mat<D>& Jinv, Real detJ, Block& out) const {
+    const Mat<D> Js = detJ * Jinv;
+    Block T;  // T(m, l) = sum_n S(m, n) Js(n, l)
+    for (int m = 0; m < D; ++m)
+      for (int l = 0; l < D; ++l) {
+        AbArray t = S_[m * D] * Js(0, l);
+        for (int n = 1; n < D; ++n) t += S_[m * D + n] * Js(n, l);
+        T[m * D + l] = t;
+      }
+    for (int k = 0; k < D; ++k)
+      for (int l = 0; l < D; ++l) {
+        AbArray o = T[l] * Jinv(0, k);
+        for (int m = 1; m < D; ++m) o += T[m * D + l] * Jinv(m, k);
+        out[k * D + l] = o;
+      }
+  }
+
+  /// C(a, b) = int_K phi_a (a . grad phi_b) for the field with nodal values `a` (rows).
+  /// nv D^2 + nv D array multiply-adds.
+  void convection(const Mat<D>& Jinv, Real detJ, const Nodal& a, AbArray& C) const {
+    const Eigen::Matrix<Real, D, nv> at = (detJ * Jinv) * a.transpose();  // at(m, c)
+    C = T_[0] * at(0, 0);
+    for (int k = 1; k < nv * D; ++k) C += T_[k] * at(k % D, k / D);
+  }
+
+  /// [k](i, j) = d_j u_i at reference vertex k, for the velocity with nodal values U (rows).
+  VertexGradients vertex_gradients(const Mat<D>& Jinv, const Nodal& U) const {
+    VertexGradients g;
+    for (int k = 0; k <= D; ++k) g[k] = (U.transpose() * dphi_vertex_[k]) * Jinv;
+    return g;
+  }
+
+  /// out[i D + j](a, b) = int_K phi_a phi_b d_j u_i from `vertex_gradients`.
+  /// D^2 (D + 1) array multiply-adds.
+  void newton(const VertexGradients& g, Real detJ, Block& out) const {
+    for (int i = 0; i < D; ++i)
+      for (int j = 0; j < D; ++j) {
+        AbArray n = M3_[0] * (detJ * g[0](i, j));
+        for (int k = 1; k <= D; ++k) n += M3_[k] * (detJ * g[k](i, j));
+        out[i * D + j] = n;
+      }
+  }
+
+ private:
+  AffineNavierStokesForms() {
+    const auto& rule = simplex_quadrature<D>(3 * V::degree);  // phi phi dphi: 3k - 1; phi phi psi: 2k + 1
+    for (auto& t : T_) t.setZero();
+    for (auto& m : M3_) m.setZero();
+    for (auto& t : S_) t.setZero();
+    M_.setZero();
+    for (int q = 0; q < rule.size(); ++q) {
+      const Real w = rule.weights[q];
+      const auto phv = V::values(rule.points[q]);
+      const auto dv = V::gradients(rule.points[q]);
+      const auto psi = P1<D>::values(rule.points[q]);
+      for (int a = 0; a < nv; ++a)
+        for (int b = 0; b < nv; ++b) {
+          const int ab = a + nv * b;
+          M_[ab] += w * phv[a] * phv[b];
+          for (int m = 0; m < D; ++m)
+            for (int n = 0; n < D; ++n) S_[m * D + n][ab] += w * dv(a, m) * dv(b, n);
+          for (int k = 0; k <= D; ++k) M3_[k][ab] += w * phv[a] * phv[b] * psi[k];
+          for (int c = 0; c < nv; ++c)
+            for (int m = 0; m < D; ++m) T_[c * D + m][ab] += w * phv[a] * phv[c] * dv(b, m);
+        }
+    }
+    for (int c = 0; c < nv; ++c) p1_nodes_.row(c) = P1<D>::values(V::node(c)).transpose();
+    for (int k = 0; k <= D; ++k) dphi_vertex_[k] = V::gradients(reference_vertex<D>(k));
+  }
+
+  std::array<AbArray, D * D> S_;      // S_[m D + n](a, b) = int_ref d^_m phi_a d^_n phi_b
+  AbArray M_;                         // M_(a, b) = int_ref phi_a phi_b
+  std::array<AbArray, nv * D> T_;     // T_[c D + m](a, b) = int_ref phi_a phi_c d^_m phi_b
+  std::array<AbArray, D + 1> M3_;     // M3_[k](a, b) = int_ref phi_a phi_b psi_k
+  Eigen::Matrix<Real, nv, D + 1> p1_nodes_;
+  std::array<typename V::Gradients, D + 1> dphi_vertex_;
 };
 
 }  // namespace alefsi

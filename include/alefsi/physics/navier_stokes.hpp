@@ -44,11 +44,14 @@ struct StepInputs {
 };
 
 /// The ALE Navier–Stokes element kernel (affine cells).
-/// - Mass, viscous and divergence blocks of the Jacobian from precomputed reference integrals
-///   (`AffineStokesForms`), no quadrature.
-/// - Convection and GLS terms of the Jacobian, and the residual, by the quadrature rule of the
-///   exact degree of their (polynomial) integrands: 3k - 1 with convection (P2/P1: 7 points in
-///   2D, 14 in 3D; P1/P1: 3 / 4), 2k without — instead of 3k + 1 (12 / 64 and 6 / 14 points).
+/// - Mass, viscous, convection, Newton and divergence terms of the Jacobian and of the residual
+///   from precomputed reference integrals (`AffineNavierStokesForms`, `AffineStokesForms`), no
+///   quadrature: the velocity block is formed per component pair as nv x nv arrays and
+///   written into A once; the residual of these terms is their matrix times (u_th, p), plus
+///   the mass matrix times (a0 u + h) / dt.
+/// - GLS terms (stabilised pairs) by the quadrature rule of the exact degree of their
+///   (polynomial) integrands: 3k - 1 with convection (P1/P1: 3 points in 2D, 4 in 3D), 2k
+///   without.
 /// - The body-force terms (not polynomial) with the former rule of degree 3k + 1.
 /// Equal to `AleNavierStokesQuadratureKernel` to round-off. `cell` is const and thread-safe
 /// (so must the force function be).
@@ -59,7 +62,9 @@ class AleNavierStokesKernel {
   using V = typename Space::VelocityElement;
   using P = typename Space::PressureElement;
   using Forms = AffineStokesForms<D, Pair>;
+  using NsForms = AffineNavierStokesForms<D, Pair>;
   static constexpr int nv = V::n_dofs, np = P::n_dofs, n_local = Space::n_local;
+  using Nodal = Eigen::Matrix<Real, nv, D>;  ///< nodal values of a velocity, row = node
   /// Degree of the quadrature of the polynomial terms (exact) and of the body-force terms.
   static constexpr int degree = Convection ? 3 * V::degree - 1 : 2 * V::degree;
   static constexpr int force_degree = 3 * V::degree + 1;
@@ -67,7 +72,8 @@ class AleNavierStokesKernel {
   using LocalMat = Eigen::Matrix<Real, n_local, n_local>;
 
   AleNavierStokesKernel(const Space& space, Real rho, Real mu, Linearisation lin = Linearisation::newton)
-      : space_(&space), rho_(rho), mu_(mu), lin_(lin), forms_(&Forms::get()), tab_(degree), ftab_(force_degree) {
+      : space_(&space), rho_(rho), mu_(mu), lin_(lin), forms_(&Forms::get()), nsforms_(&NsForms::get()),
+        tab_(degree), ftab_(force_degree) {
     ALEFSI_CHECK_ARG(rho > 0 && std::isfinite(rho), "rho", "fluid density must be positive and finite, got ", rho);
     ALEFSI_CHECK_ARG(mu > 0 && std::isfinite(mu), "mu", "viscosity must be positive and finite, got ", mu);
   }
@@ -90,7 +96,7 @@ class AleNavierStokesKernel {
     const Real th = s_.theta, dt = s_.dt, a0 = s_.a0;
     const bool newton = Convection && lin_ == Linearisation::newton;
     // local nodal data
-    Eigen::Matrix<Real, nv, D> U, Uth, H, Us;
+    Nodal U, Uth, H, Us;
     Eigen::Matrix<Real, np, 1> Pl;
     for (int a = 0; a < nv; ++a)
       for (int i = 0; i < D; ++i) {
@@ -112,13 +118,73 @@ class AleNavierStokesKernel {
       Vec<D> a_star = (Us.transpose() * phic) - Vm.transpose() * P1<D>::values(xi_c);
       tau_c = tau(c, a_star);
     }
-    // --- Jacobian: mass, viscous and divergence blocks, no quadrature ----------------------
+    // --- velocity-velocity block, from reference integrals (no quadrature) --------------------
+    // Per component pair (i, j) an nv x nv array over (a, b) (lane a + nv b):
+    //   L_ij = mu (G_ji + delta_ij tr G) + delta_ij rho C   (viscous + convection, acting on u_th)
+    //   residual   r_(a,i) = sum_j (L_ij u_th,j)_a + rho / dt (M (a0 u + h))_(a,i) - (p, d_i phi_a)
+    //   Jacobian   theta L_ij + delta_ij rho a0 / dt M + (Newton) theta rho N_ij
+    using AbArray = typename NsForms::AbArray;
+    using NvMat = Eigen::Matrix<Real, nv, nv>;
+    auto as_mat = [](const AbArray& x) { return Eigen::Map<const NvMat>(x.data()); };
+    typename NsForms::Block L;
+    nsforms_->gradient_pairs(Jinv, detJ, L);  // L[k D + l] = G_kl for now
+    {
+      AbArray diag = L[0];
+      for (int k = 1; k < D; ++k) diag += L[k * D + k];
+      diag *= mu_;
+      if constexpr (Convection) {
+        // convecting velocity a = c - v in the velocity space (c = u_th for Newton, else u*)
+        const Nodal Anod = (newton ? Uth : Us) - nsforms_->p1_at_nodes() * Vm;
+        AbArray C;
+        nsforms_->convection(Jinv, detJ, Anod, C);
+        diag += rho_ * C;
+      }
+      for (int i = 0; i < D; ++i)
+        for (int j = i + 1; j < D; ++j) std::swap(L[i * D + j], L[j * D + i]);  // G_ji
+      for (int k = 0; k < D * D; ++k) L[k] *= mu_;
+      for (int i = 0; i < D; ++i) L[i * D + i] += diag;
+    }
+    const AbArray mass = (detJ * rho_ / dt) * nsforms_->reference_mass();
+    Nodal rv = as_mat(mass) * (a0 * U + H);
+    for (int i = 0; i < D; ++i)
+      for (int j = 0; j < D; ++j) rv.col(i).noalias() += as_mat(L[i * D + j]) * Uth.col(j);
+    typename NsForms::Block Jb;
+    if (newton) {
+      nsforms_->newton(nsforms_->vertex_gradients(Jinv, Uth), detJ, Jb);
+      for (int k = 0; k < D * D; ++k) Jb[k] = th * (L[k] + rho_ * Jb[k]);
+    } else {
+      for (int k = 0; k < D * D; ++k) Jb[k] = th * L[k];
+    }
+    for (int i = 0; i < D; ++i) Jb[i * D + i] += a0 * mass;
     A.setZero();
-    r.setZero();
-    forms_->add_mass(detJ, rho_ * a0 / dt, A);
-    forms_->add_viscous(Jinv, detJ, th * mu_, A);
-    forms_->add_divergence(Jinv, detJ, -1.0, -th, A);
-    // convecting velocity a = c - v at the points of `rule` (c = u_th for Newton, else u*)
+    for (int b = 0; b < nv; ++b)
+      for (int j = 0; j < D; ++j) {
+        Real* col = A.col(D * b + j).data();
+        for (int a = 0; a < nv; ++a)
+          for (int i = 0; i < D; ++i) col[D * a + i] = Jb[i * D + j][a + nv * b];
+      }
+    // --- divergence: -(p, div w) and -(q, div u_th) -------------------------------------------
+    {
+      const auto dv = forms_->divergence(Jinv, detJ);  // dv[i][a np + b] = int_K psi_b d_i phi_a
+      for (int a = 0; a < nv; ++a)
+        for (int i = 0; i < D; ++i)
+          for (int b = 0; b < np; ++b) {
+            const Real v = dv[i][a * np + b];
+            A(D * a + i, D * nv + b) = -v;
+            A(D * nv + b, D * a + i) = -th * v;
+            rv(a, i) -= v * Pl[b];
+          }
+      for (int b = 0; b < np; ++b) {
+        Real d = 0;
+        for (int a = 0; a < nv; ++a)
+          for (int i = 0; i < D; ++i) d += dv[i][a * np + b] * Uth(a, i);
+        r[D * nv + b] = -d;
+      }
+    }
+    for (int a = 0; a < nv; ++a)
+      for (int i = 0; i < D; ++i) r[D * a + i] = rv(a, i);
+    // --- GLS: SUPG + PSPG (P1 velocity: no second derivatives), by the exact-degree rule -------
+    // convecting velocity a = c - v at a point (c = u_th for Newton, else u*)
     auto convecting = [&](const Vec<D>& xi, const Eigen::Matrix<Real, nv, 1>& phv) {
       Vec<D> aq = Vec<D>::Zero();
       if constexpr (Convection) {
@@ -127,44 +193,19 @@ class AleNavierStokesKernel {
       }
       return aq;
     };
-    const auto& rule = *tab_.rule;
-    for (int q = 0; q < rule.size(); ++q) {
-      const Real w = rule.weights[q] * detJ;
-      const Eigen::Matrix<Real, nv, D> G = tab_.dphi_v[q] * Jinv;
-      const auto& phv = tab_.phi_v[q];
-      const auto& php = tab_.phi_p[q];
-      const Vec<D> uq = U.transpose() * phv;
-      const Vec<D> hq = H.transpose() * phv;
-      const Mat<D> gu = Uth.transpose() * G;  // (i, j) = d u_th,i / d x_j
-      const Real pq = php.dot(Pl);
-      const Vec<D> aq = convecting(rule.points[q], phv);
-      const Eigen::Matrix<Real, nv, 1> adg = G * aq;  // a . grad phi_a
-      const Vec<D> dtu = (a0 * uq + hq) / dt;
-      const Vec<D> conv = gu * aq;
-      const Real divu = gu.trace();
-      // --- residual (the body force: below) ---------------------------------------------
-      const Mat<D> sigma = mu_ * (gu + gu.transpose());
-      for (int a = 0; a < nv; ++a)
-        for (int i = 0; i < D; ++i)
-          r[D * a + i] += w * (rho_ * (dtu[i] + conv[i]) * phv[a] + sigma.row(i).dot(G.row(a)) - pq * G(a, i));
-      for (int b = 0; b < np; ++b) r[D * nv + b] -= w * php[b] * divu;
-      // --- Jacobian: convection ---------------------------------------------------------
-      if constexpr (Convection) {
-        const Real wr = w * th * rho_;
-        for (int b = 0; b < nv; ++b)
-          for (int a = 0; a < nv; ++a) {
-            const Real fa = wr * phv[a];
-            const Real adv = fa * adg[b];
-            for (int i = 0; i < D; ++i) A(D * a + i, D * b + i) += adv;
-            if (newton) {
-              const Real fab = fa * phv[b];
-              for (int j = 0; j < D; ++j)
-                for (int i = 0; i < D; ++i) A(D * a + i, D * b + j) += fab * gu(i, j);
-            }
-          }
-      }
-      // --- GLS: SUPG + PSPG (P1 velocity: no second derivatives) ------------------------------
-      if constexpr (Pair::stabilised) {
+    if constexpr (Pair::stabilised) {
+      const auto& rule = *tab_.rule;
+      for (int q = 0; q < rule.size(); ++q) {
+        const Real w = rule.weights[q] * detJ;
+        const Eigen::Matrix<Real, nv, D> G = tab_.dphi_v[q] * Jinv;
+        const auto& phv = tab_.phi_v[q];
+        const Vec<D> uq = U.transpose() * phv;
+        const Vec<D> hq = H.transpose() * phv;
+        const Mat<D> gu = Uth.transpose() * G;  // (i, j) = d u_th,i / d x_j
+        const Vec<D> aq = convecting(rule.points[q], phv);
+        const Eigen::Matrix<Real, nv, 1> adg = G * aq;  // a . grad phi_a
+        const Vec<D> dtu = (a0 * uq + hq) / dt;
+        const Vec<D> conv = gu * aq;
         const Eigen::Matrix<Real, np, D> Gp = tab_.dphi_p[q] * Jinv;
         const Vec<D> gp = Gp.transpose() * Pl;
         const Vec<D> R = rho_ * (dtu + conv) + gp;  // - f: below
@@ -234,6 +275,7 @@ class AleNavierStokesKernel {
   Real rho_, mu_;
   Linearisation lin_;
   const Forms* forms_;
+  const NsForms* nsforms_;
   ReferenceTables<D, Pair> tab_, ftab_;
   StepInputs<D> s_;
 };

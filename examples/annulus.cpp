@@ -24,6 +24,12 @@
 //       Time-order study that exercises the coupling: mu = 1, rho_1 = 1.25 (Figure 7 set-up),
 //       outer wall started smoothly, omega_2(t) = 1 - exp(-(t/TAU)^4), TAU = 0.1; errors at
 //       T = 0.4 for dt = DT 2^-k (DT = 0.02): velocity L2 and inner angular velocity.
+//   annulus speed [same options as smooth] [--lins newton,semi]
+//       Speed against error (paper 6.3, the smooth-start coupled case of `smooth`): for every
+//       scheme and linearisation (Newton, semi-implicit), E at T (velocity L2 against the FD
+//       reference and against the fine-dt FEM solution: BDF3/BDF3E with Newton at
+//       dt = DT 2^-KR) and the run's wall and CPU time (process CPU time, std::clock) for
+//       dt = DT 2^-k, k = 0..K. Plot: docs/img/annulus_speed_plot.py.
 //   annulus fig7 [--pair th|gls] [--h H] [--dt DT] [--scheme S] [--csv FILE]
 //       Figure 7: mu = rho_f = 1, t* (the inner cylinder reaches omega = 1/2, half the final
 //       value) against I^ = rho_1 / 64 for rho_1 = 1e-6 .. 1e2, FEM (MR/AB as in the paper)
@@ -37,6 +43,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -272,6 +279,73 @@ int time_orders(const Scene& sc, const Settings& s, bool paper) {
   return 0;
 }
 
+// --- speed against error --------------------------------------------------------------------
+// Every (linearisation, scheme, dt) run is timed from the flow's construction to the last step
+// (mesh-velocity set-up, symbolic analysis and every step included: the time to solution);
+// the error evaluation at T is not timed.
+int speed_error(const Scene& sc, const Settings& s, const std::vector<Linearisation>& lins) {
+  const Mesh<2> mesh = make_mesh(sc, s);
+  const int kref = s.kref >= 0 ? s.kref : s.kmax + 3;
+  const int n0 = int(std::lround(s.T / s.dt0));
+  std::printf("annulus speed/error: R1 = %g, R2 = %g, rho = %g, mu = %g, rho_1 = %g, %s start (ramp %g); T = %g\n", sc.r1,
+              sc.r2, sc.rho, sc.mu, sc.rho_s, sc.ramp > 0 ? "smooth" : "impulsive", sc.ramp, s.T);
+  std::printf("mesh: %ld nodes, %ld triangles (h = %g), pair %s, %s\n", long(mesh.n_nodes()), long(mesh.n_cells()), s.h,
+              s.pair == "th" ? "P2/P1" : "P1/P1-GLS", Solver::name);
+  reference::AnnulusSolver fd(sc.fd_problem(), {6000, s.dt0 / 1024, 2});
+  fd.advance_to(s.T);
+  VecX uref;
+  Real eref_fd = 0;
+  with_types(s.pair, s.ref_scheme, [&]<class Pair, class Scheme>() {
+    const int n = n0 << kref;
+    simulate<Pair, Scheme>(mesh, sc, s.dt0 / (1 << kref), n, Linearisation::newton,
+                           [&](const auto& flow, int k, const StepReport&) {
+                             if (k == n) uref = flow.field(), eref_fd = error_vs_fd(flow, fd);
+                           });
+  });
+  std::printf("FD reference N = 6000, dt = %g; fine-dt FEM %s + Newton, dt = %g: %.4e from FD (the spatial error)\n",
+              s.dt0 / 1024, display_name(s.ref_scheme), s.dt0 / (1 << kref), eref_fd);
+  std::ofstream csv;
+  if (!s.csv.empty()) {
+    csv.open(s.csv);
+    csv << "scheme,linearisation,k,dt,steps,E_fd,E_time,omega_err_fd,newton_avg,wall_s,cpu_s\n";
+  }
+  std::printf("\n| scheme | linearisation | dt | E vs FD | E vs fine-dt FEM | iterations/step | wall (s) | CPU (s) |\n"
+              "|---|---|---|---|---|---|---|---|\n");
+  for (Linearisation lin : lins)
+    for (const auto& key : s.schemes)
+      for (int k = 0; k <= s.kmax; ++k) {
+        const Real dt = s.dt0 / (1 << k);
+        const int n = n0 << k;
+        Real efd = NAN, et = NAN, ew = NAN, wall = 0, cpu = 0;
+        long its = 0;
+        try {
+          with_types(s.pair, key, [&]<class Pair, class Scheme>() {
+            const auto w0 = Clock::now();
+            const std::clock_t c0 = std::clock();
+            simulate<Pair, Scheme>(mesh, sc, dt, n, lin, [&](const auto& flow, int step, const StepReport& rep) {
+              its += rep.newton_iterations;
+              if (step < n) return;
+              wall = std::chrono::duration<double>(Clock::now() - w0).count();
+              cpu = Real(std::clock() - c0) / CLOCKS_PER_SEC;
+              efd = error_vs_fd(flow, fd), et = error_vs_field(flow, uref);
+              ew = std::abs(flow.body_velocity(0)[2] - fd.omega());
+            });
+          });
+        } catch (const Error& e) {
+          std::printf("| %s | %d | %g | failed: %s |\n", display_name(key), k, dt, e.what());
+          continue;
+        }
+        const char* ln = lin == Linearisation::newton ? "newton" : "semi";
+        std::printf("| %s | %s | %.6g | %.4e | %.4e | %.2f | %.2f | %.2f |\n", display_name(key), ln, dt, efd, et,
+                    Real(its) / n, wall, cpu);
+        if (csv.is_open())
+          csv << key << ',' << ln << ',' << k << ',' << dt << ',' << n << ',' << efd << ',' << et << ',' << ew << ','
+              << Real(its) / n << ',' << wall << ',' << cpu << '\n'
+              << std::flush;
+      }
+  return 0;
+}
+
 // --- Figure 7 ----------------------------------------------------------------------------------
 int figure7(const Scene& base, const Settings& s) {
   const Mesh<2> mesh = make_mesh(base, s);
@@ -341,7 +415,7 @@ std::vector<std::string> split(const std::string& str) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: %s table1|smooth|fig7 [options] (see the file comment)\n", argv[0]);
+    std::fprintf(stderr, "usage: %s table1|smooth|speed|fig7 [options] (see the file comment)\n", argv[0]);
     return 2;
   }
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress of long sweeps under nohup
@@ -349,7 +423,9 @@ int main(int argc, char** argv) {
   Scene sc;
   Settings s;
   if (mode == "smooth") sc.mu = 1, sc.ramp = 0.1, s.T = 0.4, s.dt0 = 0.02, s.h = 0.05;
+  if (mode == "speed") sc.mu = 1, sc.ramp = 0.1, s.T = 0.4, s.dt0 = 0.02, s.h = 0.08;
   if (mode == "fig7") sc.mu = 1, s.schemes = {"MR_AB"};
+  std::vector<Linearisation> lins = {Linearisation::newton, Linearisation::semi_implicit};
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
     if (i + 1 >= argc) {
@@ -365,6 +441,10 @@ int main(int argc, char** argv) {
     else if (a == "--kref") s.kref = std::atoi(v.c_str());
     else if (a == "--ref-scheme") s.ref_scheme = v;
     else if (a == "--lin") s.lin = v == "semi" ? Linearisation::semi_implicit : Linearisation::newton;
+    else if (a == "--lins") {
+      lins.clear();
+      for (const auto& l : split(v)) lins.push_back(l == "semi" ? Linearisation::semi_implicit : Linearisation::newton);
+    }
     else if (a == "--csv") s.csv = v;
     else if (a == "--mu") sc.mu = std::atof(v.c_str());
     else if (a == "--rho-s") sc.rho_s = std::atof(v.c_str());
@@ -381,6 +461,7 @@ int main(int argc, char** argv) {
   try {
     if (mode == "table1") return time_orders(sc, s, true);
     if (mode == "smooth") return time_orders(sc, s, false);
+    if (mode == "speed") return speed_error(sc, s, lins);
     if (mode == "fig7") return figure7(sc, s);
     std::fprintf(stderr, "unknown mode %s\n", mode.c_str());
     return 2;

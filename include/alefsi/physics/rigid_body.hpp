@@ -12,7 +12,10 @@
 /// motion x = x_g + R(theta - theta_0) (x_0 - x_g0), so a body keeps its shape.
 /// A *free* body's Z are unknowns of the flow system: its rows are eq. (11),
 ///     M (delta_l Z) / dt - M g + (fluid terms through the columns of H) = 0,
-/// with M = diag(m, m, I). A *prescribed* body moves with Z(t) given by the user; its surface
+/// with M = diag(m, m, I). A massless free body (m = 0 and I = 0, e.g. `massless_sphere`) has
+/// no inertia rows: its rows are the force and torque balance, what a squirmer or a phoretic
+/// particle satisfies in Stokes flow (the system stays nonsingular as long as the fluid
+/// problem is, e.g. with a Dirichlet wall). A *prescribed* body moves with Z(t) given by the user; its surface
 /// velocities are then Dirichlet data.
 ///
 ///     RigidBody2D disk{.tag = 5, .mass = pi * r * r * rho_s, .inertia = 0.5 * mass * r * r,
@@ -33,6 +36,7 @@
 
 #include "alefsi/core/error.hpp"
 #include "alefsi/core/types.hpp"
+#include "alefsi/mesh/mesh.hpp"
 
 namespace alefsi {
 
@@ -59,9 +63,14 @@ struct RigidBody2D {
   void validate(std::size_t index) const {
     const std::string who = "bodies[" + std::to_string(index) + "]";
     if (free()) {
-      ALEFSI_CHECK_ARG(mass > 0 && std::isfinite(mass), who + ".mass", "must be positive and finite, got ", mass);
-      ALEFSI_CHECK_ARG(inertia > 0 && std::isfinite(inertia), who + ".inertia", "must be positive and finite, got ",
-                       inertia);
+      ALEFSI_CHECK_ARG(mass >= 0 && std::isfinite(mass), who + ".mass",
+                       "must be positive and finite (or 0 for a massless, force-free body), got ", mass);
+      if (mass == 0)
+        ALEFSI_CHECK_ARG(inertia == 0, who + ".inertia", "a massless (force-free) body has no inertia: must be 0, got ",
+                         inertia);
+      else
+        ALEFSI_CHECK_ARG(inertia > 0 && std::isfinite(inertia), who + ".inertia", "must be positive and finite, got ",
+                         inertia);
     }
     ALEFSI_CHECK_ARG(centre.allFinite() && velocity.allFinite(), who, "non-finite initial state");
     ALEFSI_CHECK_ARG(radius >= 0 && std::isfinite(radius), who + ".radius", "must be >= 0 and finite, got ", radius);
@@ -81,19 +90,54 @@ inline RigidBody2D disk_body(int tag, const Vec<2>& centre, Real radius, Real de
   return b;
 }
 
-/// Slip velocities for RigidBody2D::slip (body frame; n = r / |r|, exact for disks).
+namespace detail {
+/// u_s = Q - (Q.n) n with n = r / |r|; with `half` != 0 only where r.half > 0, zero where
+/// r.half < 0 and half the value on the dividing set |r.half| <= 1e-9 |r| |half| (see
+/// tangential_slip).
+template <int D>
+Vec<D> tangential_slip_value(const Vec<D>& Q, const Vec<D>& half, const Vec<D>& r) {
+  const Vec<D> n = r.normalized();
+  const Vec<D> u = Q - Q.dot(n) * n;
+  if (half.squaredNorm() == 0) return u;
+  const Real side = r.dot(half), tol = 1e-9 * r.norm() * half.norm();
+  if (side > tol) return u;
+  if (side < -tol) return Vec<D>::Zero();
+  return 0.5 * u;  // on the dividing line (2D: two points) / circle (3D)
+}
+}  // namespace detail
+
+/// Slip velocities for RigidBody2D::slip and RigidBody3D::slip (body frame; n = r / |r|, exact
+/// for disks and spheres centred at the centre of mass).
 ///
 /// `tangential_slip(Q)`: the tangential projection of a constant field Q, u_s = Q - (Q.n) n
 /// (the paper's sections 6.1 and 6.4); with `half` set, only on the half surface r.half > 0
-/// (zero elsewhere). On a disk, Q = -B1 e gives the squirmer mode B1 sin(theta) e_theta
-/// (theta from e), which swims along +e at B1 / 2 in an unbounded 2D fluid (Blake 1971).
+/// (zero where r.half < 0). On the dividing set r.half = 0 (two points of a disk, the circle
+/// of a sphere; |r.half| <= 1e-9 |r| |half|) the value is half the one-sided one, the mean of
+/// the two sides: a mesh whose edges follow that circle then carries, at its nodes there, the
+/// value whose consistent surface quadrature (P2: the edge midpoints carry the weight) equals
+/// the mean of the two one-sided interpolants, so the O(h) error of a one-sided convention
+/// cancels (exactly on a mesh mirror-symmetric about the dividing plane; docs/theory.md).
+/// On a disk, Q = -B1 e gives the squirmer mode B1 sin(theta) e_theta (theta from e), which
+/// swims along +e at B1 / 2 in an unbounded 2D fluid (Blake 1971). On a sphere, Q = -B1 e is
+/// the mode B1 sin(theta) e_theta, swimming at 2 B1 / 3; with a half space, for any Q and unit
+/// `half` e, the unbounded sphere translates at V = -<u_s> = -Q / 3 and turns at
+/// w = -3 / (8 pi R^3) int n x u_s dS = -3 / (8 R) e x Q (Fair & Anderson 1989; paper 6.1).
+///
+///     squirmer.slip = tangential_slip(Vec<3>(-1, 0, 0), Vec<3>(1, 0, 0));  // V = (1/3, 0, 0)
 inline std::function<Vec<2>(const Vec<2>&)> tangential_slip(const Vec<2>& Q, const Vec<2>& half = Vec<2>::Zero()) {
-  ALEFSI_CHECK_ARG(Q.allFinite() && half.allFinite(), "Q", "must be finite");
-  return [Q, half](const Vec<2>& r) -> Vec<2> {
-    if (half.squaredNorm() > 0 && r.dot(half) <= 0) return Vec<2>::Zero();
-    const Vec<2> n = r.normalized();
-    return Q - Q.dot(n) * n;
-  };
+  ALEFSI_CHECK_ARG(Q.allFinite(), "Q", "must be finite");
+  ALEFSI_CHECK_ARG(half.allFinite(), "half", "must be finite");
+  return [Q, half](const Vec<2>& r) -> Vec<2> { return detail::tangential_slip_value<2>(Q, half, r); };
+}
+/// 3D overload of tangential_slip (constrained so that a 2-vector expression picks the 2D one).
+template <class DerivedQ>
+  requires(DerivedQ::SizeAtCompileTime == 3)
+std::function<Vec<3>(const Vec<3>&)> tangential_slip(const Eigen::MatrixBase<DerivedQ>& Qexpr,
+                                                     const Vec<3>& half = Vec<3>::Zero()) {
+  const Vec<3> Q = Qexpr;
+  ALEFSI_CHECK_ARG(Q.allFinite(), "Q", "must be finite");
+  ALEFSI_CHECK_ARG(half.allFinite(), "half", "must be finite");
+  return [Q, half](const Vec<3>& r) -> Vec<3> { return detail::tangential_slip_value<3>(Q, half, r); };
 }
 /// The squirmer modes u_s = (B1 sin(theta) + B2 sin(theta) cos(theta)) e_theta, theta the angle
 /// of r from the unit swimming axis e (body frame), e_theta its counter-clockwise tangent.
@@ -148,8 +192,11 @@ struct RigidBody3D {
 
   void validate(std::size_t index) const {
     const std::string who = "bodies[" + std::to_string(index) + "]";
-    if (free()) {
-      ALEFSI_CHECK_ARG(mass > 0 && std::isfinite(mass), who + ".mass", "must be positive and finite, got ", mass);
+    if (free() && mass == 0) {
+      ALEFSI_CHECK_ARG(inertia.isZero(0), who + ".inertia", "a massless (force-free) body has no inertia: must be 0");
+    } else if (free()) {
+      ALEFSI_CHECK_ARG(mass > 0 && std::isfinite(mass), who + ".mass",
+                       "must be positive and finite (or 0 for a massless, force-free body), got ", mass);
       ALEFSI_CHECK_ARG(inertia.allFinite() && (inertia - inertia.transpose()).norm() <= 1e-12 * inertia.norm(),
                        who + ".inertia", "must be a finite symmetric 3x3 tensor");
       const Eigen::SelfAdjointEigenSolver<Mat<3>> es(inertia, Eigen::EigenvaluesOnly);
@@ -175,6 +222,64 @@ inline RigidBody3D sphere_body(int tag, const Vec<3>& centre, Real radius, Real 
   b.centre = centre;
   b.radius = radius;
   return b;
+}
+
+/// A free, massless sphere (m = 0, I = 0): its rows are the pure force and torque balance of
+/// the fluid on it (plus any external load), as for a phoretic particle or a squirmer in
+/// Stokes flow (paper 6.1); see RigidBody3D::validate.
+inline RigidBody3D massless_sphere(int tag, const Vec<3>& centre, Real radius) {
+  ALEFSI_CHECK_ARG(radius > 0 && std::isfinite(radius), "radius", "must be positive and finite, got ", radius);
+  RigidBody3D b;
+  b.tag = tag;
+  b.centre = centre;
+  b.radius = radius;
+  return b;
+}
+
+/// The body's slip made compatible with incompressibility on its mesh: returns
+/// u_s(r) - c n(r), n = r / |r|, with c such that the discrete flux of the new slip through the
+/// body's polygonal surface (facets tagged body.tag in `mesh`, at the body's initial place) is
+/// zero. Why: with Dirichlet walls all round, the discrete continuity equations sum to "net
+/// flux through the boundary = 0". A rigid velocity satisfies that exactly (its interpolant is
+/// exact and V + w x r is divergence-free), a slip tangent to the *sphere* does not: through
+/// the flat facets its interpolant leaks a flux of O(h^2) (cancelling only by symmetry, e.g.
+/// for a slip on the whole sphere on a symmetric mesh), which the pinned pressure DOF then
+/// absorbs as a point source, polluting the body's velocity (measured on a mirror-symmetric
+/// mesh with the hemisphere slip of paper 6.1, h = R / 3: V_y = 6e-5 instead of 0). The
+/// correction is a uniform normal velocity of O(h^2), which exerts no force or torque on a
+/// sphere. Flux of the interpolant on a flat facet f: |f| / 3 times the sum over its edge
+/// midpoints (velocity degree 2: the vertex weights vanish) or over its vertices (degree 1).
+///
+///     squirmer.slip = tangential_slip(Vec<3>(-1, 0, 0), Vec<3>(1, 0, 0));
+///     squirmer.slip = flux_free_slip(squirmer, mesh);   // before flow.add_body(squirmer)
+inline std::function<Vec<3>(const Vec<3>&)> flux_free_slip(const RigidBody3D& body, const Mesh<3>& mesh,
+                                                           int velocity_degree = 2, Real* removed = nullptr) {
+  ALEFSI_CHECK_ARG(body.slip != nullptr, "body.slip", "the body has no slip");
+  ALEFSI_CHECK_ARG(velocity_degree == 1 || velocity_degree == 2, "velocity_degree", "must be 1 or 2, got ",
+                   velocity_degree);
+  const auto slip = body.slip;
+  const Eigen::Quaternion<Real> q = body.orientation;
+  auto flux = [&](const std::function<Vec<3>(const Vec<3>&)>& f) {
+    Real phi = 0;
+    bool any = false;
+    for (Index k : mesh.boundary_facets()) {
+      if (mesh.facet_tag(k) != body.tag) continue;
+      any = true;
+      const auto& fv = mesh.facet(k);
+      const std::array<Vec<3>, 3> x{mesh.node(fv[0]), mesh.node(fv[1]), mesh.node(fv[2])};
+      Vec<3> n = 0.5 * (x[1] - x[0]).cross(x[2] - x[0]);  // |n| = area
+      if (n.dot(x[0] + x[1] + x[2] - 3 * body.centre) < 0) n = -n;
+      for (int i = 0; i < 3; ++i) {
+        const Vec<3> p = velocity_degree == 2 ? Vec<3>(0.5 * (x[i] + x[(i + 1) % 3])) : x[i];
+        phi += n.dot(q * f(q.conjugate() * (p - body.centre))) / 3;
+      }
+    }
+    ALEFSI_CHECK_ARG(any, "body.tag", "no boundary facet of the mesh has tag ", body.tag);
+    return phi;
+  };
+  const Real c = flux(slip) / flux([](const Vec<3>& r) { return Vec<3>(r.normalized()); });
+  if (removed) *removed = c;
+  return [slip, c](const Vec<3>& r) { return Vec<3>(slip(r) - c * r.normalized()); };
 }
 
 /// [v]_x, the matrix of v x (.).

@@ -19,7 +19,7 @@
 // is made of mesh edges, and the slip's jump there is integrated as the smooth even extension
 // of the eastern slip (docs/theory.md). --mesh full meshes the whole cube without symmetry.
 //
-// How to run: ./sphere_squirmer [--h0 0.025] [--growth 0.3] [--half-side 100] [--hmax 20]
+// How to run: ./sphere_squirmer [--h0 0.04] [--growth 0.5] [--half-side 100] [--hmax 50]
 //             [--mesh octant|full] [--msh FILE] [--geo FILE] [--output DIR] [--no-translation]
 //             [--grid 161]
 // What it prints: mesh and DOF counts, V and w of the squirmer with their errors against the
@@ -32,9 +32,9 @@
 // NaN inside the sphere) and decay.csv (|u| against r along the x and y axes, the diagonal and
 // averaged over 200 directions, both cases). `python3 examples/plot_sphere_squirmer.py DIR`
 // draws Figure 3 (streamlines on z = 0) and Figure 4 (|u| against r, log-log).
-// Expected: |V_x - 1/3| / (1/3) well under 1 % at h0 = R / 10 and spurious V_y, V_z, w at
-// round-off level on the symmetric mesh (docs/results.md has the measured table and the
-// resolution and box-size study).
+// Expected: |V_x - 1/3| / (1/3) under 1 % from h0 = R / 3 on (0.03 % at the default R / 6),
+// spurious V_y, V_z, w at round-off level on the symmetric mesh (docs/results.md has the
+// measured table and the resolution and box-size study).
 #include <alefsi/alefsi.hpp>
 
 #include <sys/resource.h>
@@ -58,11 +58,11 @@
 using namespace alefsi;
 using std::numbers::pi;
 
-#if defined(SQ_UNSYM)
-struct Solver : UmfPackLu { Solver() : UmfPackLu(UmfPackLu::Strategy::SQ_UNSYM) {} };
-#elif defined(SQ_SPLU)
-using Solver = SparseLu<>;
-#elif defined(ALEFSI_HAVE_SUITESPARSE)
+// UMFPACK (symmetric strategy) was the fastest of UMFPACK symmetric / automatic / unsymmetric
+// and SparseLu<> on the 40k-unknown mesh (10 / 10 / 20 / 27 s CPU), SparseLu the leanest
+// (0.9 GB against 1.5 GB); UMFPACK's 32-bit version (Eigen's wrapper) stops with "out of
+// memory" near 9e4 unknowns (docs/results.md).
+#if defined(ALEFSI_HAVE_SUITESPARSE)
 using Solver = UmfPackLu;  // la/suitesparse.hpp: multifrontal LU, symmetric strategy
 #else
 using Solver = SparseLu<>;
@@ -75,7 +75,7 @@ constexpr int tag_walls = 1, tag_sphere = 5;
 
 // --- options -----------------------------------------------------------------------------------
 struct Options {
-  Real h0 = 0.025, growth = 0.3, half_side = 100, hmax = 20;
+  Real h0 = 0.04, growth = 0.5, half_side = 100, hmax = 50;
   bool octant = true, translation = true;
   int grid = 161;
   std::string msh, geo = ALEFSI_EXAMPLES_DIR "/sphere_squirmer.geo";

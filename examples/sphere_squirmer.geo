@@ -8,9 +8,9 @@
 //               after mirroring), sphere 5, fluid 10.
 //   octant = 0: the whole cube, cut by the plane x = 0 so the equator is conforming; no
 //               symmetry. Tags: walls 1, sphere 5, fluid 10.
-// Run: gmsh -3 sphere_squirmer.geo -setnumber h0 0.025 -setnumber H 100 -format msh41 -o out.msh
+// Run: gmsh -3 sphere_squirmer.geo -setnumber h0 0.04 -setnumber H 100 -format msh41 -o out.msh
 SetFactory("OpenCASCADE");
-DefineConstant[ R = 0.25, H = 100, h0 = 0.025, g = 0.3, hmax = 20, octant = 1 ];
+DefineConstant[ R = 0.25, H = 100, h0 = 0.04, g = 0.5, hmax = 50, octant = 1 ];
 If (octant)
   Box(1) = {0, 0, 0, H, H, H};
   Sphere(2) = {0, 0, 0, R};

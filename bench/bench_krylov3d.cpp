@@ -1,0 +1,277 @@
+// The iterative path for 3D (la/krylov.hpp) against the direct solvers on the 3D Stokes
+// systems: lid-driven cavity on box_mesh(N, N, N) (6 N^3 tetrahedra), P2/P1 and P1/P1-GLS,
+// mu = 1, every boundary velocity fixed (lid z = 1: (1, 0, 0)), pressure DOF 0 pinned.
+// Optionally (--mass G) a time-step mass term G * M_u is added to the velocity block (the
+// (rho a0 / dt) part of an ALE step) to exercise the Cahouet–Chabard Schur approximation.
+// Results and discussion: docs/solvers.md, "Iterative path for 3D".
+//
+//   cmake --build build/bench --target bench_krylov3d
+//   OPENBLAS_NUM_THREADS=1 build/bench/bench/bench_krylov3d --sizes 8,12,16 --pairs P2P1
+//
+// Options: --sizes N,N,..  (default 8,16)
+//          --pairs P2P1,P1P1GLS   (default both)
+//          --solvers a,b,..  (default krylov,krylov-mass,umfpack): krylov (SaddlePointGmres<3>,
+//                   algebraic Schur), krylov-mass (with saddle_point_blocks: pressure mass,
+//                   Cahouet–Chabard when --mass > 0), umfpack (UmfPackLu symmetric), sparselu
+//                   (SparseLu<>)
+//          --direct-max N   (default 16) largest N for the direct solvers
+//          --tol T   (default 1e-8) GMRES relative tolerance; --restart M (default 60)
+//          --strength THETA, --sweeps S   AMG strength threshold (0.08) and Gauss–Seidel sweeps (1)
+//          --mass G  (default 0) add G * M_u (consistent velocity mass) to the velocity block
+//
+// One markdown line per (pair, N, solver): unknowns, nnz, set-up (analyse + factorise) CPU s,
+// solve CPU s, wall s of both, GMRES iterations, AMG levels and operator complexity, peak RSS
+// (VmHWM after a reset before that solver; includes the problem, 'base' MB), ||K x - b|| / ||b||,
+// and ||x - x_direct|| / ||x_direct|| when a direct solution is there.
+#include <malloc.h>
+#include <time.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "alefsi/fem/constraints.hpp"
+#include "alefsi/fem/dofmap.hpp"
+#include "alefsi/la/assembler.hpp"
+#include "alefsi/la/krylov.hpp"
+#include "alefsi/la/solvers.hpp"
+#include "alefsi/la/suitesparse.hpp"
+#include "alefsi/mesh/generate/structured.hpp"
+#include "alefsi/physics/stokes.hpp"
+
+namespace {
+
+using namespace alefsi;
+
+double cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+double wall_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+double status_mb(const char* key) {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  const std::size_t n = std::strlen(key);
+  while (std::getline(f, line))
+    if (line.compare(0, n, key) == 0) return std::stod(line.substr(n + 1)) / 1024.0;
+  return -1;
+}
+void reset_peak_rss() {
+  malloc_trim(0);
+  std::ofstream f("/proc/self/clear_refs");
+  f << "5";
+}
+
+struct System {
+  SparseMatrix A;
+  VecX b;
+  SaddlePointBlocks blocks;
+};
+
+// consistent scalar velocity mass, added as gamma * M to every component of the free velocities
+template <class Pair>
+void add_velocity_mass(const MixedSpace<3, Pair>& space, const DofConstraints& cons, Real gamma, SparseMatrix& A) {
+  using V = typename Pair::template Velocity<3>;
+  const auto& rule = simplex_quadrature<3>(2 * V::degree);
+  Eigen::Matrix<Real, V::n_dofs, V::n_dofs> ref = Eigen::Matrix<Real, V::n_dofs, V::n_dofs>::Zero();
+  for (int q = 0; q < rule.size(); ++q) {
+    const auto phi = V::values(rule.points[q]);
+    for (int a = 0; a < V::n_dofs; ++a)
+      for (int c = 0; c < V::n_dofs; ++c) ref(a, c) += rule.weights[q] * phi[a] * phi[c];
+  }
+  const auto& mesh = space.mesh();
+  for (Index c = 0; c < mesh.n_cells(); ++c) {
+    const Real m = gamma * mesh.measure(c) / reference_measure<3>;
+    const auto& dofs = space.velocity().cell_dofs(c);
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < V::n_dofs; ++a) {
+        const Index fa = space.velocity_field(dofs[a], k);
+        if (cons.kind(fa) != DofConstraints::Kind::free) continue;
+        for (int e = 0; e < V::n_dofs; ++e) {
+          const Index fe = space.velocity_field(dofs[e], k);
+          if (cons.kind(fe) != DofConstraints::Kind::free) continue;
+          A.coeffRef(cons.indices(fa)[0], cons.indices(fe)[0]) += m * ref(a, e);  // in the pattern
+        }
+      }
+  }
+}
+
+template <class Pair>
+System cavity(int n, Real gamma) {
+  const Mesh<3> mesh = box_mesh(n, n, n);
+  MixedSpace<3, Pair> space(mesh);
+  StokesKernel<3, Pair> kernel(space, 1.0);
+  DofConstraints cons(space.n_field());
+  const auto& vel = space.velocity();
+  std::vector<char> done(vel.n_dofs(), 0);
+  for (int t : {tags::zmax, 1, 2, 3, 4, 5})
+    for (Index i : vel.boundary_dofs(t)) {
+      if (done[i]) continue;
+      done[i] = 1;
+      for (int k = 0; k < 3; ++k) cons.fix(space.velocity_field(i, k), (t == tags::zmax && k == 0) ? 1.0 : 0.0);
+    }
+  cons.fix(space.pressure_field(0), 0.0);
+  cons.finalize();
+  Assembler<MixedSpace<3, Pair>::n_local> asmb(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
+  System s;
+  VecX r;
+  asmb.assemble(kernel, cons.expand(VecX::Zero(cons.n_unknowns())), &s.A, &r);
+  s.b = -r;
+  if (gamma > 0) add_velocity_mass(space, cons, gamma, s.A);
+  s.blocks = saddle_point_blocks(space, cons, 1.0, gamma);
+  return s;
+}
+
+struct Options {
+  std::vector<int> sizes{8, 16};
+  std::vector<std::string> pairs{"P2P1", "P1P1GLS"};
+  std::vector<std::string> solvers{"krylov", "krylov-mass", "umfpack"};
+  int direct_max = 16;
+  double mass = 0;
+  KrylovOptions krylov;
+};
+
+bool has(const std::vector<std::string>& v, const std::string& s) {
+  for (const auto& x : v)
+    if (x == s) return true;
+  return false;
+}
+
+template <class T>
+std::vector<T> split(const std::string& s) {
+  std::vector<T> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    std::stringstream is(item);
+    T v;
+    is >> v;
+    out.push_back(v);
+  }
+  return out;
+}
+
+struct Row {
+  double setup = 0, solve = 0, wall = 0, peak = 0, relres = 0;
+  int iterations = -1, levels = 0;
+  double complexity = 0;
+};
+
+template <class Solver>
+Row run(const System& s, Solver solver, VecX& x) {
+  Row row;
+  reset_peak_rss();
+  const double c0 = cpu_seconds(), w0 = wall_seconds();
+  solver.analyze(s.A);
+  solver.factorize(s.A);
+  const double c1 = cpu_seconds();
+  x = solver.solve(s.b);
+  const double c2 = cpu_seconds(), w2 = wall_seconds();
+  row.setup = c1 - c0;
+  row.solve = c2 - c1;
+  row.wall = w2 - w0;
+  row.peak = status_mb("VmHWM:");
+  row.relres = (s.A * x - s.b).norm() / s.b.norm();
+  if constexpr (requires { solver.iterations(); solver.velocity_amg(); }) {
+    row.iterations = solver.iterations();
+    row.levels = solver.velocity_amg().n_levels();
+    row.complexity = solver.velocity_amg().operator_complexity();
+  }
+  return row;
+}
+
+template <class Pair>
+void bench(const Options& o, const char* pair) {
+  for (int n : o.sizes) {
+    const double c0 = cpu_seconds();
+    const System s = cavity<Pair>(n, o.mass);
+    const double assemble = cpu_seconds() - c0;
+    const double base = status_mb("VmRSS:");
+    std::optional<VecX> direct;
+    auto print = [&](const char* solver, const Row& r, const VecX& x) {
+      std::printf("| %s | %d | %d | %.3g | %s | %.3g | %.3g | %.3g | %s | %s | %.0f | %.1e | %s |\n", pair, n,
+                  int(s.A.rows()), double(s.A.nonZeros()), solver, r.setup, r.solve, r.wall,
+                  r.iterations >= 0 ? std::to_string(r.iterations).c_str() : "",
+                  r.levels ? (std::to_string(r.levels) + " / " + std::to_string(r.complexity).substr(0, 4)).c_str() : "",
+                  r.peak, r.relres,
+                  direct ? ([&] {
+                    char buf[32];
+                    std::snprintf(buf, sizeof buf, "%.1e", (x - *direct).norm() / direct->norm());
+                    return std::string(buf);
+                  }()).c_str()
+                         : "");
+      std::fflush(stdout);
+    };
+    std::fprintf(stderr, "%s N = %d: %d unknowns, assembled in %.1f s CPU, base %.0f MB\n", pair, n, int(s.A.rows()),
+                 assemble, base);
+    VecX x;
+#ifdef ALEFSI_HAVE_SUITESPARSE
+    if (has(o.solvers, "umfpack") && n <= o.direct_max) {
+      const Row r = run(s, UmfPackLu{}, x);
+      direct = x;
+      print("UMFPACK, symmetric", r, x);
+    }
+#endif
+    if (has(o.solvers, "sparselu") && n <= o.direct_max) {
+      const Row r = run(s, SparseLu<>{}, x);
+      if (!direct) direct = x;
+      print("SparseLU, saddle-point AMD", r, x);
+    }
+    if (has(o.solvers, "krylov")) {
+      const Row r = run(s, SaddlePointGmres<3>(o.krylov), x);
+      print("GMRES + AMG, lumped Schur", r, x);
+    }
+    if (has(o.solvers, "krylov-mass")) {
+      SaddlePointGmres<3> k(o.krylov);
+      k.set_blocks(s.blocks);
+      const Row r = run(s, std::move(k), x);
+      print(o.mass > 0 ? "GMRES + AMG, mass + Cahouet–Chabard" : "GMRES + AMG, pressure mass", r, x);
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "missing value after %s\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--sizes") o.sizes = split<int>(next());
+    else if (a == "--pairs") o.pairs = split<std::string>(next());
+    else if (a == "--solvers") o.solvers = split<std::string>(next());
+    else if (a == "--direct-max") o.direct_max = std::stoi(next());
+    else if (a == "--tol") o.krylov.tolerance = std::stod(next());
+    else if (a == "--restart") o.krylov.restart = std::stoi(next());
+    else if (a == "--strength") o.krylov.amg.strength = std::stod(next());
+    else if (a == "--sweeps") o.krylov.amg.sweeps = std::stoi(next());
+    else if (a == "--cycles") o.krylov.velocity_cycles = std::stoi(next());
+    else if (a == "--coarse") o.krylov.amg.coarse_size = std::stoi(next());
+    else if (a == "--mass") o.mass = std::stod(next());
+    else {
+      std::fprintf(stderr, "unknown option %s\n", a.c_str());
+      return 2;
+    }
+  }
+  std::printf("| pair | N | unknowns | nnz | solver | set-up s | solve s | wall s | its | AMG levels / complexity | peak MB | residual | vs direct |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  if (has(o.pairs, "P2P1")) bench<TaylorHood>(o, "P2/P1");
+  if (has(o.pairs, "P1P1GLS")) bench<P1P1Gls>(o, "P1/P1-GLS");
+  return 0;
+}

@@ -1,0 +1,442 @@
+#pragma once
+/// \file la/krylov.hpp
+/// An iterative solver policy for the flow systems: GMRES preconditioned by a block-triangular
+/// saddle-point preconditioner, for the 3D systems where a direct factorisation runs out of
+/// memory or time (numbers: docs/solvers.md, "Iterative path for 3D").
+///
+/// The unknowns of a flow system (fem/constraints.hpp over fem/dofmap.hpp's field order) come
+/// as [u | p | z]: the free velocity components (interleaved, all D components of a node
+/// together: every constraint of the library fixes or links whole nodes), the free pressures,
+/// then the extra unknowns (rigid-body velocities, d(d+1)/2 per free body). With v = [u; z]
+///     K = [ A   Bt ]        preconditioner  P = [ A~  Bt  ]
+///         [ B  -C  ]                            [ 0  -S~  ],
+/// C = 0 for Taylor–Hood, the GLS/PSPG pressure block for P1/P1-GLS. Applying P^-1:
+/// p = -S~^-1 r_p, then v = A~^-1 (r_v - Bt p), inside restarted GMRES (right preconditioning:
+/// the residual it monitors is the true one). P^-1 is a fixed linear operator.
+///   - A~^-1: one smoothed-aggregation AMG V-cycle (la/amg.hpp) on the velocity-velocity block
+///     A_uu (components labelled, so aggregates do not mix them); the few body unknowns z are
+///     eliminated exactly around it: with M = the V-cycle, Y = M A_uz (one V-cycle per body
+///     unknown at set-up) and the dense body Schur complement S_z = A_zz - A_zu Y,
+///     u' = M r_u, z = S_z^-1 (r_z - A_zu u'), u = u' - Y z.
+///   - S~ approximates the Schur complement S = B A^-1 Bt + C:
+///       * with `SaddlePointBlocks` from the space (`saddle_point_blocks`), the Cahouet–Chabard
+///         form S~^-1 = mu M_p^-1 + L^-1, M_p the pressure mass matrix (inverted by a few
+///         Jacobi–Chebyshev steps) and, when the velocity block holds gamma M_u (a time step:
+///         gamma = rho a_0 / dt), L = B (gamma M_u,lumped)^-1 Bt + C (one AMG V-cycle);
+///       * without them (the policy default-constructed, as `AleFlow` does), algebraically:
+///         S~ = diag(B diag(A_uu)^-1 Bt) + diag(C), a lumped stand-in for M_p / mu. It is
+///         spectrally equivalent to M_p / mu on shape-regular meshes (steady Stokes: mesh-independent
+///         iteration counts), but it has no Cahouet–Chabard part: with a dominant rho/dt mass
+///         the counts grow with refinement. The pressure unknowns are then found from the
+///         matrix: the contiguous range of unknowns whose diagonal entry is <= 0 (zero for
+///         Taylor–Hood, -C_ii < 0 for GLS; every velocity and body diagonal is > 0).
+///
+/// `analyze(A)` finds the block split (once per pattern); `factorize(A)` builds the AMG
+/// hierarchies and Schur approximations (values are read: per matrix); `solve(b)` iterates until
+/// ||b - K x|| <= tolerance ||b|| and throws `SolverError` when `max_iterations` are spent.
+/// Lifetime: `solve` multiplies by the matrix given to `factorize`, which must stay alive and
+/// unchanged until the last `solve` (as for UmfPackLu).
+///
+///     alefsi::SaddlePointGmres<3> krylov({.tolerance = 1e-10});
+///     krylov.set_blocks(alefsi::saddle_point_blocks(space, cons, mu));   // optional
+///     krylov.analyze(J);  krylov.factorize(J);  VecX du = krylov.solve(-r);
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "alefsi/core/eigen_sparse.hpp"
+#include "alefsi/core/error.hpp"
+#include "alefsi/fem/constraints.hpp"
+#include "alefsi/fem/dofmap.hpp"
+#include "alefsi/fem/quadrature.hpp"
+#include "alefsi/la/amg.hpp"
+#include "alefsi/la/solvers.hpp"
+
+namespace alefsi {
+
+/// What the space knows about a flow system's unknowns [u | p | z] (see the file comment).
+struct SaddlePointBlocks {
+  Index n_pressure = 0;                 ///< free pressure unknowns, after the velocity ones
+  Index n_extra = 0;                    ///< trailing extra (body) unknowns
+  std::vector<int> velocity_component;  ///< per velocity unknown, 0..D-1 (empty: interleaved)
+  SparseMatrix pressure_mass;           ///< M_p on the pressure unknowns (empty: algebraic S~)
+  Real mu = 1;                          ///< viscosity: S ~ M_p / mu
+  VecX velocity_mass;                   ///< lumped M_u per velocity unknown (for Cahouet–Chabard)
+  Real mass_coefficient = 0;            ///< gamma: A_uu holds gamma M_u (rho a_0 / dt; 0: steady)
+};
+
+/// The blocks of the system assembled on `space` through `cons`: pressure mass matrix
+/// (quadrature exact for the pressure element), HRZ-lumped velocity mass (diagonal of the
+/// consistent mass, scaled per cell to the cell's measure: positive for P2, whose row sums are
+/// not) when mass_coefficient > 0.
+template <int D, ElementPair Pair>
+SaddlePointBlocks saddle_point_blocks(const MixedSpace<D, Pair>& space, const DofConstraints& cons, Real mu,
+                                      Real mass_coefficient = 0) {
+  ALEFSI_CHECK_ARG(cons.finalized(), "cons", "must be finalized");
+  ALEFSI_CHECK_ARG(cons.n_field() == space.n_field(), "cons", "was built for another space");
+  ALEFSI_CHECK_ARG(mu > 0 && std::isfinite(mu), "mu", "must be positive and finite, got ", mu);
+  ALEFSI_CHECK_ARG(mass_coefficient >= 0, "mass_coefficient", "must be >= 0, got ", mass_coefficient);
+  using P = typename Pair::template Pressure<D>;
+  using V = typename Pair::template Velocity<D>;
+  const Index nvf = D * space.velocity().n_dofs();
+  SaddlePointBlocks blk;
+  blk.mu = mu;
+  blk.mass_coefficient = mass_coefficient;
+  Index nu = 0;
+  for (Index f = 0; f < nvf; ++f)
+    if (cons.kind(f) == DofConstraints::Kind::free) {
+      ALEFSI_ASSERT(cons.indices(f)[0] == nu);
+      blk.velocity_component.push_back(int(f % D));
+      ++nu;
+    }
+  for (Index k = 0; k < space.pressure().n_dofs(); ++k)
+    if (cons.kind(space.pressure_field(k)) == DofConstraints::Kind::free) ++blk.n_pressure;
+  blk.n_extra = cons.n_unknowns() - nu - blk.n_pressure;
+  ALEFSI_CHECK_ARG(blk.n_extra == cons.n_unknowns() - cons.n_free(), "cons",
+                   "constrains pressure DOFs by links: not a [u | p | z] system");
+  const auto& mesh = space.mesh();
+  // pressure mass
+  {
+    const auto& rule = simplex_quadrature<D>(2 * P::degree);
+    Eigen::Matrix<Real, P::n_dofs, P::n_dofs> ref = Eigen::Matrix<Real, P::n_dofs, P::n_dofs>::Zero();
+    for (int q = 0; q < rule.size(); ++q) {
+      const auto phi = P::values(rule.points[q]);
+      for (int a = 0; a < P::n_dofs; ++a)
+        for (int b = 0; b < P::n_dofs; ++b) ref(a, b) += rule.weights[q] * phi[a] * phi[b];
+    }
+    std::vector<Eigen::Triplet<Real, Index>> t;
+    t.reserve(std::size_t(mesh.n_cells()) * P::n_dofs * P::n_dofs);
+    for (Index c = 0; c < mesh.n_cells(); ++c) {
+      const Real m = mesh.measure(c) / reference_measure<D>;
+      const auto& dofs = space.pressure().cell_dofs(c);
+      std::array<Index, P::n_dofs> u{};
+      for (int a = 0; a < P::n_dofs; ++a) {
+        const Index f = space.pressure_field(dofs[a]);
+        u[a] = cons.kind(f) == DofConstraints::Kind::free ? cons.indices(f)[0] - nu : -1;
+      }
+      for (int a = 0; a < P::n_dofs; ++a)
+        for (int b = 0; b < P::n_dofs; ++b)
+          if (u[a] >= 0 && u[b] >= 0) t.emplace_back(u[a], u[b], m * ref(a, b));
+    }
+    blk.pressure_mass.resize(blk.n_pressure, blk.n_pressure);
+    blk.pressure_mass.setFromTriplets(t.begin(), t.end());
+  }
+  // lumped velocity mass
+  if (mass_coefficient > 0) {
+    const auto& rule = simplex_quadrature<D>(2 * V::degree);
+    std::array<Real, V::n_dofs> diag{};
+    for (int q = 0; q < rule.size(); ++q) {
+      const auto phi = V::values(rule.points[q]);
+      for (int a = 0; a < V::n_dofs; ++a) diag[a] += rule.weights[q] * phi[a] * phi[a];
+    }
+    Real sum = 0;
+    for (Real d : diag) sum += d;
+    VecX scalar = VecX::Zero(space.velocity().n_dofs());
+    for (Index c = 0; c < mesh.n_cells(); ++c) {
+      const auto& dofs = space.velocity().cell_dofs(c);
+      for (int a = 0; a < V::n_dofs; ++a) scalar[dofs[a]] += mesh.measure(c) * diag[a] / sum;
+    }
+    blk.velocity_mass.resize(nu);
+    for (Index f = 0; f < nvf; ++f)
+      if (cons.kind(f) == DofConstraints::Kind::free) blk.velocity_mass[cons.indices(f)[0]] = scalar[f / D];
+  }
+  return blk;
+}
+
+struct KrylovOptions {
+  Real tolerance = 1e-8;     ///< on ||b - K x|| / ||b||
+  int max_iterations = 1000;
+  int restart = 60;          ///< GMRES restart length (memory: restart + 1 vectors)
+  int mass_steps = 3;        ///< Jacobi–Chebyshev steps for M_p^-1 (explicit blocks)
+  int velocity_cycles = 1;   ///< AMG V-cycles per velocity solve (stationary iteration: linear)
+  AmgOptions amg = {};       ///< velocity block (and Cahouet–Chabard Laplacian) AMG
+};
+
+/// Restarted GMRES with the block-triangular AMG/Schur preconditioner (file comment).
+/// `D`: the number of velocity components per node (the dimension).
+template <int D>
+class SaddlePointGmres {
+ public:
+  static constexpr const char* name = "GMRES+block(AMG, Schur)";
+
+  explicit SaddlePointGmres(KrylovOptions opt = {})
+      : opt_(opt), amg_(opt.amg), laplace_amg_(opt.amg), mass_amg_(opt.amg) {
+    ALEFSI_CHECK_ARG(opt.tolerance > 0 && opt.tolerance < 1, "tolerance", "must be in (0, 1), got ", opt.tolerance);
+    ALEFSI_CHECK_ARG(opt.max_iterations >= 1, "max_iterations", "must be positive");
+    ALEFSI_CHECK_ARG(opt.restart >= 1, "restart", "must be positive");
+    ALEFSI_CHECK_ARG(opt.mass_steps >= 1, "mass_steps", "must be positive");
+    ALEFSI_CHECK_ARG(opt.velocity_cycles >= 1, "velocity_cycles", "must be positive");
+  }
+
+  /// Block layout and Schur data from the space (optional; see the file comment). Takes effect
+  /// at the next `analyze`/`factorize`.
+  void set_blocks(SaddlePointBlocks blocks) {
+    blocks_ = std::move(blocks);
+    analyzed_ = false;
+  }
+
+  /// Finds the split [u | p | z] (from the blocks, or from the diagonal's sign).
+  void analyze(const SparseMatrix& A) {
+    ALEFSI_CHECK_ARG(A.rows() == A.cols(), "A", "must be square");
+    n_ = A.rows();
+    if (blocks_) {
+      np_ = blocks_->n_pressure;
+      ne_ = blocks_->n_extra;
+      nu_ = n_ - np_ - ne_;
+      ALEFSI_CHECK_ARG(nu_ > 0 && np_ > 0 && ne_ >= 0, "A", "size ", n_, " does not match the blocks (", np_,
+                       " pressures, ", ne_, " extras)");
+      comp_ = blocks_->velocity_component;
+      ALEFSI_CHECK_ARG(comp_.empty() || Index(comp_.size()) == nu_, "blocks.velocity_component",
+                       "needs one label per velocity unknown");
+    } else {
+      Index first = -1, last = -1;
+      for (Index j = 0; j < n_; ++j)
+        if (!(A.coeff(j, j) > 0)) {
+          if (first < 0) first = j;
+          last = j;
+        }
+      if (first < 0) throw SolverError(std::string(name) + ": no unknown with a diagonal <= 0: not a saddle-point system");
+      for (Index j = first; j <= last; ++j)
+        if (A.coeff(j, j) > 0)
+          throw SolverError(std::string(name) + ": the unknowns with a diagonal <= 0 are not contiguous; pass the blocks (set_blocks)");
+      nu_ = first;
+      np_ = last + 1 - first;
+      ne_ = n_ - last - 1;
+      comp_.clear();
+    }
+    if (comp_.empty()) {
+      comp_.assign(std::size_t(nu_), 0);
+      if (nu_ % D == 0)
+        for (Index i = 0; i < nu_; ++i) comp_[i] = int(i % D);
+    }
+    analyzed_ = true;
+  }
+
+  void factorize(const SparseMatrix& A) {
+    if (!analyzed_ || A.rows() != n_) analyze(A);
+    A_ = &A;
+    const Index p0 = nu_, e0 = nu_ + np_;
+    RowSparseMatrix Ar = A;
+    RowSparseMatrix Auu = Ar.topLeftCorner(nu_, nu_);
+    amg_.compute(std::move(Auu), comp_);
+    const RowSparseMatrix Bp = Ar.middleRows(p0, np_);  // [B_u  -C  B_z]
+    Auu_ = &amg_.matrix();
+    // body unknowns: exact elimination around the V-cycle
+    if (ne_ > 0) {
+      const MatX Auz = MatX(A.block(0, e0, nu_, ne_));
+      Azu_ = MatX(Ar.block(e0, 0, ne_, nu_));
+      Y_.resize(nu_, ne_);
+      for (Index k = 0; k < ne_; ++k) Y_.col(k) = velocity_solve(Auz.col(k));
+      const MatX Sz = MatX(Ar.block(e0, e0, ne_, ne_)) - Azu_ * Y_;
+      body_lu_.compute(Sz);
+    }
+    // Schur complement approximation
+    const VecX diag_u = A.diagonal().head(nu_);
+    VecX minus_c(np_);  // diagonal of the pressure block (-C_ii)
+    for (Index i = 0; i < np_; ++i) minus_c[i] = A.coeff(p0 + i, p0 + i);
+    use_mass_ = blocks_ && blocks_->pressure_mass.rows() == np_ && np_ > 0;
+    use_laplace_ = use_mass_ && blocks_->mass_coefficient > 0 && blocks_->velocity_mass.size() == nu_;
+    if (use_mass_) {
+      // X = M_p / (2 mu) + C: Jacobi–Chebyshev on M_p when C = 0 (Taylor–Hood), else one AMG
+      // V-cycle on X
+      const SparseMatrix& M = blocks_->pressure_mass;
+      const Real scale = 1 / (2 * blocks_->mu);
+      mass_inv_diag_ = M.diagonal().cwiseInverse();
+      has_c_ = minus_c.cwiseAbs().maxCoeff() > 0;
+      if (has_c_) {
+        RowSparseMatrix X = scale * RowSparseMatrix(M);
+        X -= RowSparseMatrix(Bp.middleCols(p0, np_));  // + C
+        mass_amg_.compute(std::move(X));
+      } else {
+        // Jacobi–Chebyshev interval: [lambda_max / 5, 1.1 lambda_max] of D^-1 M (P1: [1/2, 5/2] in 3D)
+        VecX v = VecX::Ones(np_);
+        Real lambda = 1;
+        for (int k = 0; k < 20; ++k) {
+          VecX w = mass_inv_diag_.cwiseProduct(M * v);
+          lambda = w.norm() / v.norm();
+          v = w / w.norm();
+        }
+        cheb_hi_ = 1.1 * lambda;
+        cheb_lo_ = lambda / 5;
+      }
+      mass_scale_ = scale;
+      if (use_laplace_) {
+        const VecX inv_m = (blocks_->mass_coefficient * blocks_->velocity_mass).cwiseInverse();
+        const RowSparseMatrix Bu = Bp.leftCols(nu_);
+        const RowSparseMatrix Bt = Ar.block(0, p0, nu_, np_);
+        RowSparseMatrix L = Bu * inv_m.asDiagonal() * Bt;
+        laplace_amg_.compute(std::move(L));
+      }
+    } else {
+      // s_i = sum_j B_ij Bt_ji / A_jj over velocity unknowns j (B and Bt from the matrix);
+      // S~ = diag(s) + C: diagonal when C = 0, else one AMG V-cycle
+      VecX sd(np_);
+      for (Index i = 0; i < np_; ++i) {
+        Real s = 0;
+        SparseMatrix::InnerIterator bt(A, p0 + i);  // column p0 + i: Bt_ji, sorted by j
+        for (RowSparseMatrix::InnerIterator b(Bp, i); b && b.col() < nu_; ++b) {
+          while (bt && bt.row() < b.col()) ++bt;
+          if (bt && bt.row() == b.col()) s += b.value() * bt.value() / diag_u[b.col()];
+        }
+        if (!(s - minus_c[i] > 0))
+          throw SolverError(std::string(name) + ": non-positive Schur diagonal at pressure unknown " + std::to_string(i));
+        sd[i] = s;
+      }
+      has_c_ = minus_c.cwiseAbs().maxCoeff() > 0;
+      if (has_c_) {
+        RowSparseMatrix X = -RowSparseMatrix(Bp.middleCols(p0, np_));  // C
+        for (Index i = 0; i < np_; ++i) X.coeffRef(i, i) += sd[i];
+        mass_amg_.compute(std::move(X));
+      } else {
+        schur_inv_diag_ = sd.cwiseInverse();
+      }
+    }
+    V_.resize(0, 0);
+  }
+
+  VecX solve(const VecX& b) {
+    if (!A_) throw SolverError(std::string(name) + ": solve before factorize");
+    ALEFSI_CHECK_ARG(b.size() == n_, "b", "has ", b.size(), " entries, expected ", n_);
+    const SparseMatrix& A = *A_;
+    const int m = opt_.restart;
+    VecX x = VecX::Zero(n_);
+    iterations_ = 0;
+    const Real bnorm = b.norm();
+    residual_ = 0;
+    if (bnorm == 0) return x;
+    const Real target = opt_.tolerance * bnorm;
+    if (V_.cols() != m + 1 || V_.rows() != n_) V_.resize(n_, m + 1);
+    MatX H = MatX::Zero(m + 1, m);
+    VecX g(m + 1), cs(m), sn(m), w(n_);
+    VecX r = b;
+    Real rnorm = r.norm();
+    while (rnorm > target) {
+      if (iterations_ >= opt_.max_iterations)
+        throw SolverError(std::string(name) + " did not converge: " + std::to_string(iterations_) +
+                          " iterations, relative residual " + std::to_string(rnorm / bnorm));
+      V_.col(0) = r / rnorm;
+      g.setZero();
+      g[0] = rnorm;
+      H.setZero();
+      int k = 0;
+      while (k < m && iterations_ < opt_.max_iterations) {
+        w.noalias() = A * precondition(V_.col(k));
+        for (int i = 0; i <= k; ++i) {  // modified Gram–Schmidt
+          H(i, k) = w.dot(V_.col(i));
+          w.noalias() -= H(i, k) * V_.col(i);
+        }
+        H(k + 1, k) = w.norm();
+        if (H(k + 1, k) > 0) V_.col(k + 1) = w / H(k + 1, k);
+        for (int i = 0; i < k; ++i) {  // earlier rotations
+          const Real t = cs[i] * H(i, k) + sn[i] * H(i + 1, k);
+          H(i + 1, k) = -sn[i] * H(i, k) + cs[i] * H(i + 1, k);
+          H(i, k) = t;
+        }
+        const Real h = std::hypot(H(k, k), H(k + 1, k));
+        cs[k] = H(k, k) / h;
+        sn[k] = H(k + 1, k) / h;
+        H(k, k) = h;
+        H(k + 1, k) = 0;
+        g[k + 1] = -sn[k] * g[k];
+        g[k] = cs[k] * g[k];
+        ++k;
+        ++iterations_;
+        if (std::abs(g[k]) <= target) break;
+      }
+      const VecX y = H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
+      x.noalias() += precondition(V_.leftCols(k) * y);
+      r.noalias() = b - A * x;
+      rnorm = r.norm();
+    }
+    residual_ = rnorm / bnorm;
+    return x;
+  }
+
+  /// The preconditioner P^-1 r (for tests and diagnostics).
+  VecX precondition(const VecX& r) const {
+    const Index p0 = nu_;
+    VecX z(n_);
+    // pressure: p = -S~^-1 r_p
+    auto rp = r.segment(p0, np_);
+    VecX p;
+    if (use_mass_) {
+      p = has_c_ ? mass_amg_.apply(rp) : VecX(mass_solve(rp) / mass_scale_);
+      if (use_laplace_) p += laplace_amg_.apply(rp);
+    } else {
+      p = has_c_ ? mass_amg_.apply(rp) : VecX(schur_inv_diag_.cwiseProduct(rp));
+    }
+    p = -p;
+    z.segment(p0, np_) = p;
+    // velocity and bodies: A~ v = r_v - Bt p
+    const VecX t = r - A_->middleCols(p0, np_) * p;
+    VecX u = velocity_solve(t.head(nu_));
+    if (ne_ > 0) {
+      const VecX ze = body_lu_.solve(t.tail(ne_) - Azu_ * u);
+      u.noalias() -= Y_ * ze;
+      z.tail(ne_) = ze;
+    }
+    z.head(nu_) = u;
+    return z;
+  }
+
+  /// GMRES iterations and final relative residual of the last solve.
+  int iterations() const { return iterations_; }
+  Real residual() const { return residual_; }
+  Index n_velocity() const { return nu_; }
+  Index n_pressure() const { return np_; }
+  Index n_extra() const { return ne_; }
+  const SmoothedAggregationAmg& velocity_amg() const { return amg_; }
+  bool cahouet_chabard() const { return use_laplace_; }
+  bool pressure_mass() const { return use_mass_; }
+
+ private:
+  // velocity_cycles V-cycles on A_uu x = b from x = 0
+  VecX velocity_solve(const VecX& b) const {
+    VecX x = amg_.apply(b);
+    for (int k = 1; k < opt_.velocity_cycles; ++k) x += amg_.apply(b - *Auu_ * x);
+    return x;
+  }
+
+  // a few Jacobi–Chebyshev steps for M_p x = r (a fixed polynomial in D^-1 M: linear)
+  VecX mass_solve(const VecX& rhs) const {
+    const SparseMatrix& M = blocks_->pressure_mass;
+    const Real theta = (cheb_hi_ + cheb_lo_) / 2, delta = (cheb_hi_ - cheb_lo_) / 2;
+    const Real sigma = theta / delta;
+    Real rho = 1 / sigma;
+    VecX x = VecX::Zero(rhs.size()), r = rhs;
+    VecX d = mass_inv_diag_.cwiseProduct(r) / theta;
+    for (int k = 0; k < opt_.mass_steps; ++k) {
+      x += d;
+      if (k + 1 == opt_.mass_steps) break;
+      r.noalias() -= M * d;
+      const Real rho_next = 1 / (2 * sigma - rho);
+      d *= rho_next * rho;
+      d.noalias() += (2 * rho_next / delta) * mass_inv_diag_.cwiseProduct(r);
+      rho = rho_next;
+    }
+    return x;
+  }
+
+  KrylovOptions opt_;
+  std::optional<SaddlePointBlocks> blocks_;
+  bool analyzed_ = false, use_mass_ = false, use_laplace_ = false, has_c_ = false;
+  Index n_ = 0, nu_ = 0, np_ = 0, ne_ = 0;
+  std::vector<int> comp_;
+  const SparseMatrix* A_ = nullptr;
+  const RowSparseMatrix* Auu_ = nullptr;
+  SmoothedAggregationAmg amg_, laplace_amg_, mass_amg_;
+  MatX Y_, Azu_;
+  Eigen::PartialPivLU<MatX> body_lu_;
+  VecX schur_inv_diag_, mass_inv_diag_;
+  Real cheb_lo_ = 0.5, cheb_hi_ = 2.5, mass_scale_ = 1;
+  MatX V_;
+  int iterations_ = 0;
+  Real residual_ = 0;
+};
+
+static_assert(LinearSolver<SaddlePointGmres<3>>, "SaddlePointGmres must model LinearSolver");
+
+}  // namespace alefsi

@@ -385,3 +385,65 @@ TEST_CASE("assembly with partly fixed nodes and a 6-unknown link equals the dens
   // fewer stored positions than DOF pairs (blocks of 2 on the interior nodes)
   CHECK(asmb.n_positions() < std::size_t(mesh.n_cells()) * Space::n_local * Space::n_local / 2);
 }
+
+namespace {
+// Assembles the Navier-Stokes Newton Jacobian and residual (every step input set) on 1 and 2
+// threads: the results must be bit-identical (same summation order, see la/assembler.hpp).
+template <int D, class Pair>
+void check_ns_threads(int n) {
+  const auto mesh = distorted_mesh<D>(n);
+  using Space = MixedSpace<D, Pair>;
+  Space space(mesh);
+  DofConstraints cons(space.n_field());
+  for (Index i : space.velocity().boundary_dofs(1))
+    for (int k = 0; k < D; ++k) cons.fix(space.velocity_field(i, k), 0.2 * k + 0.1);
+  cons.finalize();
+  const Index nf = space.n_field();
+  VecX field(nf), prev(nf), hist(nf), ustar(nf);
+  for (Index f = 0; f < nf; ++f) {
+    field[f] = std::cos(0.3 * f);
+    prev[f] = std::sin(0.7 * f + 0.2);
+    hist[f] = std::cos(0.3 * f);
+    ustar[f] = std::sin(1.9 * f) + 0.3;
+  }
+  field = cons.expand(cons.restrict_free(field));
+  std::vector<Vec<D>> vmesh(mesh.n_nodes());
+  for (Index v = 0; v < mesh.n_nodes(); ++v)
+    for (int k = 0; k < D; ++k) vmesh[v][k] = 0.2 * std::sin(2.0 * mesh.node(v)[(k + 1) % D] + k);
+  StepInputs<D> in;
+  in.dt = 0.05;
+  in.theta = 1;
+  in.a0 = 1.5;
+  in.previous = &prev;
+  in.history = &hist;
+  in.extrapolated = &ustar;
+  in.mesh_velocity = &vmesh;
+  AleNavierStokesKernel<D, Pair> k(space, 1.3, 0.05, Linearisation::newton);
+  k.set_step(in);
+  Assembler<Space::n_local> asmb(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
+  REQUIRE(asmb.n_colours() >= 2);
+  SparseMatrix J1, J2;
+  VecX r1, r2;
+  asmb.assemble(k, field, &J1, &r1);
+  asmb.set_threads(2);
+  asmb.assemble(k, field, &J2, &r2);
+  INFO(D << "D " << Pair::name << ", " << mesh.n_cells() << " cells, " << asmb.n_colours() << " colours");
+  REQUIRE(J2.nonZeros() == J1.nonZeros());
+  CHECK(std::equal(J1.outerIndexPtr(), J1.outerIndexPtr() + J1.cols() + 1, J2.outerIndexPtr()));
+  CHECK(std::equal(J1.innerIndexPtr(), J1.innerIndexPtr() + J1.nonZeros(), J2.innerIndexPtr()));
+  CHECK(std::equal(J1.valuePtr(), J1.valuePtr() + J1.nonZeros(), J2.valuePtr()));
+  CHECK(std::equal(r1.data(), r1.data() + r1.size(), r2.data()));
+  // matrix(): the same pattern, zero values
+  const SparseMatrix& M = asmb.matrix();
+  REQUIRE(M.nonZeros() == J1.nonZeros());
+  CHECK(std::equal(M.innerIndexPtr(), M.innerIndexPtr() + M.nonZeros(), J1.innerIndexPtr()));
+  CHECK(std::all_of(M.valuePtr(), M.valuePtr() + M.nonZeros(), [](Real v) { return v == 0.0; }));
+}
+}  // namespace
+
+TEST_CASE("Navier-Stokes assembly on two threads is bit-identical to one thread", "[la][assembly][threads][quick]") {
+  check_ns_threads<2, TaylorHood>(24);  // 1152 cells: 5 chunks
+  check_ns_threads<2, P1P1Gls>(24);
+  check_ns_threads<3, TaylorHood>(6);   // 1296 cells
+  check_ns_threads<3, P1P1Gls>(6);
+}

@@ -4,8 +4,11 @@
 /// scatter through precomputed positions, optionally on several threads.
 ///
 /// The global matrix is an Eigen column-major `SparseMatrix` (what SparseLU factorises) whose
-/// structure is filled once, by the constructor, from the cells' field DOFs and the
-/// `DofConstraints` (a cell couples every unknown its field DOFs depend on).
+/// structure is computed once, by the constructor, from the cells' field DOFs and the
+/// `DofConstraints` (a cell couples every unknown its field DOFs depend on). The constructor
+/// stores the pattern (column starts, row indices) and the scatter positions only; a matrix
+/// passed to `assemble` receives that pattern when its shape differs, and `matrix()` builds a
+/// zero-valued copy on demand, so no value array is allocated or touched until needed.
 ///
 /// Blocks. A cell's local unknowns are grouped into *blocks*: runs of local DOFs whose unknowns
 /// are consecutive and whose columns have the same rows (the free components of one velocity
@@ -50,6 +53,7 @@
 #include <numeric>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "alefsi/core/eigen_sparse.hpp"
@@ -92,9 +96,19 @@ class Assembler {
   Index n_unknowns() const { return cons_->n_unknowns(); }
   Index n_cells() const { return static_cast<Index>(dofs_.size()); }
   const CellDofs& cell_dofs(Index c) const { return dofs_[c]; }
-  /// The matrix with the assembled pattern (values as left by the last assembly).
-  const SparseMatrix& matrix() const { return matrix_; }
-  SparseMatrix& matrix() { return matrix_; }
+  /// A matrix with the assembled pattern and zero values (built on first call: the constructor
+  /// stores the pattern only; not thread-safe against concurrent first calls).
+  const SparseMatrix& matrix() const {
+    if (!matrix_built_) {
+      matrix_built_ = true;
+      take_pattern(matrix_);
+      std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), Real(0));
+    }
+    return matrix_;
+  }
+  SparseMatrix& matrix() { return const_cast<SparseMatrix&>(std::as_const(*this).matrix()); }
+  /// Number of stored entries of the pattern.
+  Index n_nonzeros() const { return outer_.empty() ? 0 : outer_.back(); }
   /// Number of cells that touch a linked DOF.
   Index n_linked_cells() const { return n_general_; }
   /// Number of colours of the chunk schedule (see the file comment).
@@ -123,7 +137,7 @@ class Assembler {
   void assemble(const Kernel& kernel, const VecX& field, SparseMatrix* J, VecX* r) const {
     ALEFSI_CHECK_ARG(field.size() == cons_->n_field(), "field", "has ", field.size(), " entries, expected ",
                      cons_->n_field());
-    if (J && (J->rows() != matrix_.rows() || J->nonZeros() != matrix_.nonZeros())) *J = matrix_;
+    if (J && (J->rows() != n_unknowns() || J->nonZeros() != n_nonzeros())) take_pattern(*J);  // values: zeroed below
     if (r) r->resize(n_unknowns());
     Real* val = J ? J->valuePtr() : nullptr;
     const std::size_t nnz = J ? std::size_t(J->nonZeros()) : 0;
@@ -196,6 +210,16 @@ class Assembler {
     guarded(0);
     for (auto& th : pool) th.join();
     if (error) std::rethrow_exception(error);
+  }
+
+  /// Gives `M` this assembler's pattern (n_unknowns square, compressed); its values are left
+  /// uninitialised.
+  void take_pattern(SparseMatrix& M) const {
+    const Index n = n_unknowns();
+    M.resize(n, n);
+    M.resizeNonZeros(n_nonzeros());
+    std::copy(outer_.begin(), outer_.end(), M.outerIndexPtr());
+    std::copy(inner_.get(), inner_.get() + n_nonzeros(), M.innerIndexPtr());
   }
 
   /// Scatters one element's Jacobian/residual (exposed for benchmarks and custom loops).
@@ -375,31 +399,26 @@ class Assembler {
     for (Index u = 0; u < n; ++u) gfirst[u] = same_prev[u] ? gfirst[u - 1] : u;
     std::vector<Index> gsize(n, 0);
     for (Index u = 0; u < n; ++u) ++gsize[gfirst[u]];
-    // The rows of the group starting at u0 are whole groups (a cell that touches one unknown
-    // of a group touches all of them): collect the groups of its cells' blocks with a marker
-    // array indexed by group (first unknown), unsorted.
-    std::vector<Index> mark(n, -1), groups;
-    auto collect_groups = [&](Index u0) {
-      groups.clear();
-      Index len = 0;
-      for (Index k = ustart[u0]; k < ustart[u0 + 1]; ++k) {
-        const Index c = ucell[k];
-        const Index* red = &red_[red_start_[c]];
-        for (Index b = blk_start_[c]; b < blk_start_[c + 1]; ++b) {
-          const Index v = gfirst[red[blk_[b].start]];
-          if (mark[v] != -2 - u0) {
-            mark[v] = -2 - u0;
-            groups.push_back(v);
-            len += gsize[v];
-          }
-        }
+    // per block: the group it lies in (first unknown) and its offset in that group
+    std::vector<Index> bgrp(blk_.size()), boff(blk_.size());
+    for (Index c = 0; c < nc; ++c) {
+      const Index* red = &red_[red_start_[c]];
+      for (Index b = blk_start_[c]; b < blk_start_[c + 1]; ++b) {
+        const Index u = red[blk_[b].start];
+        bgrp[b] = gfirst[u];
+        boff[b] = u - gfirst[u];
       }
-      return len;
-    };
-    // One pass, columns in order. The storage is reserved once for an upper bound of the
-    // nonzeros (sum over cells of (free unknowns)^2, ~1.7x nnz for P2/P1): pages past the
-    // final size are never touched, so they cost address space only, not memory.
-    std::int64_t bound = 0;
+    }
+    outer_.assign(std::size_t(n) + 1, 0);
+    Index* outer = outer_.data();
+    // Per group (columns u0 .. u0 + g - 1, all with the same rows): the rows are whole groups
+    // (a cell that touches one unknown of a group touches all of them), the distinct groups of
+    // its cells' blocks, found with a stamp array (branch-free), sorted (a few tens, insertion
+    // sort), expanded to unknowns. rank[v] is then the offset of group v's first row in these
+    // columns, and each cell touching the group gets the positions of its block pairs whose
+    // column block lies in it: column start + rank of the row block's group + the blocks'
+    // offsets in their groups. The columns are written in order, each exactly once.
+    std::int64_t bound = 0;  // sum over cells of (free unknowns)^2 >= nnz (~1.7x for P2/P1)
     for (Index c = 0; c < nc; ++c) {
       std::int64_t m = 0;
       for (Index b = blk_start_[c]; b < blk_start_[c + 1]; ++b) m += blk_[b].size;
@@ -408,46 +427,81 @@ class Assembler {
     bound = std::min<std::int64_t>(bound, std::int64_t(n) * n);
     if (bound > std::numeric_limits<Index>::max())
       throw SolverError("Assembler: the matrix pattern may exceed 2^31 nonzeros (Index is 32 bit)");
-    matrix_.resize(n, n);
-    matrix_.reserve(Index(bound));
-    Index* outer = matrix_.outerIndexPtr();
-    Index* inner = matrix_.innerIndexPtr();
-    outer[0] = 0;
-    // per group: its sorted rows into the matrix, and the positions of the cells' block pairs
-    // whose column block starts in it; mark[v] is then the rank of group v's first row
+    // allocated for the bound: the pages past the final size are never touched, so they cost
+    // address space, not memory
+    inner_.reset(new Index[std::size_t(bound) + 4]);  // + 4: the branch-free expansion below
+    Index* inner = inner_.get();
+    // per group: its blocks (index into blk_), in cell order
+    std::vector<Index> gbstart(n + 1, 0), gblk(blk_.size());
+    for (std::size_t b = 0; b < blk_.size(); ++b) ++gbstart[bgrp[b] + 1];
+    std::partial_sum(gbstart.begin(), gbstart.end(), gbstart.begin());
+    {
+      std::vector<Index> at(gbstart.begin(), gbstart.end() - 1);
+      for (std::size_t b = 0; b < blk_.size(); ++b) gblk[at[bgrp[b]]++] = Index(b);
+    }
+    std::vector<Index> bcell(blk_.size());  // cell of each block
+    for (Index c = 0; c < nc; ++c) std::fill(bcell.begin() + blk_start_[c], bcell.begin() + blk_start_[c + 1], c);
+    Index max_gsize = 1;
+    for (Index u = 0; u < n; ++u) max_gsize = std::max(max_gsize, gsize[u]);
+    std::vector<Index> stamp(n, -1), rank(n, 0), groups;
     for (Index u0 = 0; u0 < n;) {
       const Index g = gsize[u0];
-      const Index len = collect_groups(u0);
-      std::sort(groups.begin(), groups.end());
+      Index m = 0;
+      for (Index k = gbstart[u0]; k < gbstart[u0 + 1]; ++k) {
+        const Index c = bcell[gblk[k]];
+        const Index b0 = blk_start_[c], b1 = blk_start_[c + 1];
+        if (std::size_t(m + b1 - b0) > groups.size()) groups.resize(2 * std::size_t(m + b1 - b0));
+        for (Index b = b0; b < b1; ++b) {
+          const Index v = bgrp[b];
+          groups[m] = v;
+          m += stamp[v] != u0;
+          stamp[v] = u0;
+        }
+      }
+      sort_small(groups.data(), m);
       Index* col = inner + outer[u0];
-      Index at = 0;
-      for (Index v : groups) {
-        mark[v] = at;
-        for (Index t = 0; t < gsize[v]; ++t) col[at++] = v + t;
+      Index len = 0;
+      if (max_gsize <= 4) {  // branch-free: 4 rows per group written, the excess overwritten next
+        for (Index k = 0; k < m; ++k) {
+          const Index v = groups[k];
+          rank[v] = len;
+          for (Index t = 0; t < 4; ++t) col[len + t] = v + t;
+          len += gsize[v];
+        }
+      } else {
+        for (Index k = 0; k < m; ++k) {
+          const Index v = groups[k];
+          rank[v] = len;
+          for (Index t = 0; t < gsize[v]; ++t) col[len++] = v + t;
+        }
       }
       for (Index t = 0; t < g; ++t) outer[u0 + t + 1] = outer[u0 + t] + len;
       for (Index t = 1; t < g; ++t) std::copy(col, col + len, inner + outer[u0 + t]);
-      for (Index k = ustart[u0]; k < ustart[u0 + 1]; ++k) {
-        const Index c = ucell[k];
-        const Index* red = &red_[red_start_[c]];
-        Block* blk = &blk_[blk_start_[c]];
-        const Index nb = blk_start_[c + 1] - blk_start_[c];
-        Index* pos = &pos_[pos_start_[c]];
-        for (Index J = 0; J < nb; ++J) {
-          const Index uj = red[blk[J].start];
-          if (uj < u0 || uj >= u0 + g) continue;
-          blk[J].stride = len;
-          for (Index I = 0; I < nb; ++I) {
-            const Index ui = red[blk[I].start];
-            pos[J * nb + I] = outer[uj] + mark[gfirst[ui]] + (ui - gfirst[ui]);
-          }
-        }
+      for (Index k = gbstart[u0]; k < gbstart[u0 + 1]; ++k) {
+        const Index bj = gblk[k], c = bcell[bj];
+        const Index b0 = blk_start_[c], nb = blk_start_[c + 1] - b0;
+        blk_[bj].stride = len;
+        const Index cj = outer[u0] + boff[bj] * len;
+        Index* pj = &pos_[pos_start_[c] + (bj - b0) * nb];
+        for (Index I = 0; I < nb; ++I) pj[I] = cj + rank[bgrp[b0 + I]] + boff[b0 + I];
       }
-      for (Index v : groups) mark[v] = -1;
       u0 += g;
     }
-    matrix_.resizeNonZeros(outer[n]);  // within the reservation: no copy
-    std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), Real(0));
+  }
+
+  // Sorts x[0 .. m) ascending: insertion sort for the few tens of a column group, std::sort
+  // beyond.
+  static void sort_small(Index* x, Index m) {
+    if (m > 48) {
+      std::sort(x, x + m);
+      return;
+    }
+    for (Index i = 1; i < m; ++i) {
+      const Index v = x[i];
+      Index j = i;
+      for (; j > 0 && x[j - 1] > v; --j) x[j] = x[j - 1];
+      x[j] = v;
+    }
   }
 
   // Thread schedule: chunks of consecutive simple cells, greedily coloured (a chunk takes the
@@ -520,7 +574,10 @@ class Assembler {
   std::vector<std::int64_t> pos_start_;  // can exceed 2^31 for big 3D P2 meshes
   std::vector<Index> chunk_cells_, chunk_start_, chunk_order_, colour_start_, linked_cells_;
   int threads_ = 1;
-  SparseMatrix matrix_;
+  std::vector<Index> outer_;           // CSC pattern: column starts
+  std::unique_ptr<Index[]> inner_;     // row indices (allocated for an upper bound, outer_[n] used)
+  mutable SparseMatrix matrix_;        // matrix(): built on demand
+  mutable bool matrix_built_ = false;
 };
 
 }  // namespace alefsi

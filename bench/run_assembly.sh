@@ -5,6 +5,9 @@
 #
 #   bench/run_assembly.sh assembly   # Stokes: pattern / kernel / kernel_quad / scatter / assemble(_t2), 2D and 3D
 #   bench/run_assembly.sh ns         # Navier-Stokes Jacobian: ns_newton(_kernel|_t2), ns_semi, 2D and 3D
+#   bench/run_assembly.sh threads    # 1 against 2 threads: assemble(_t2), ns_newton(_t2), 2D and 3D
+#                                    # (needs an idle machine to mean anything: see the load printed)
+#   bench/run_assembly.sh pattern    # pattern build next to one assembly (the fill), 2D and 3D
 #   bench/run_assembly.sh lu         # SparseLU, all but the two long cases (~2 min)
 #   bench/run_assembly.sh lu-long    # 2D P2/P1 N = 256 (COLAMD) and 3D P2/P1 N = 12 (~6 min, 9.5 GB peak)
 #   bench/run_assembly.sh all
@@ -59,6 +62,8 @@ PY
 
 stokes='/(pattern|kernel|kernel_quad|scatter|assemble|assemble_t2)/'
 ns='/(ns_newton|ns_newton_kernel|ns_newton_kernel_quad|ns_newton_t2|ns_semi)/'
+threads='/(assemble|assemble_t2|ns_newton|ns_newton_t2)/'
+pattern='/(pattern|assemble)/'
 lu='P2P1/2D/lu_colamd/(16|32|64|128)/|/lu_amd/|P1P1GLS/2D/lu_colamd/|P2P1/3D/lu_colamd/(4|6|8|10)/|P1P1GLS/3D/lu_colamd/'
 lu_long='P2P1/2D/lu_colamd/256/|P2P1/3D/lu_colamd/12/'
 extra=${2:-}
@@ -66,9 +71,11 @@ with() { [[ -n $extra ]] && echo "($extra).*$1" || echo "$1"; }
 case ${1:-all} in
   assembly) run assembly "$(with "$stokes")" "$reps" ;;
   ns) run ns "$(with "$ns")" "$reps" ;;
+  threads) run threads "$(with "$threads")" "$reps" ;;
+  pattern) run pattern "$(with "$pattern")" "$reps" ;;
   lu) run lu "$(with "$lu")" 1 ;;
   lu-long) run lu-long "$(with "$lu_long")" 1 ;;
   custom) run custom "${2:?custom needs a filter}" "$reps" ;;
   all) run assembly "$stokes" "$reps"; run ns "$ns" "$reps"; run lu "$lu" 1; run lu-long "$lu_long" 1 ;;
-  *) echo "usage: $0 [assembly|ns|lu|lu-long|all] [name-prefix] | custom <filter>" >&2; exit 2 ;;
+  *) echo "usage: $0 [assembly|ns|threads|pattern|lu|lu-long|all] [name-prefix] | custom <filter>" >&2; exit 2 ;;
 esac

@@ -35,7 +35,7 @@ def streamlines(ax, path, title):
     speed = np.hypot(ux, uy)
     with np.errstate(divide="ignore", invalid="ignore"):
         logs = np.log10(np.where(speed > 0, speed, np.nan))
-    ax.pcolormesh(x / R, y / R, logs, shading="auto", cmap="viridis", vmin=-5, vmax=0)
+    ax.pcolormesh(x / R, y / R, logs, shading="auto", cmap="viridis", vmin=-7, vmax=0)
     ux = np.nan_to_num(ux)
     uy = np.nan_to_num(uy)
     ax.streamplot(x / R, y / R, ux, uy, density=1.3, color="w", linewidth=0.6, arrowsize=0.6)
@@ -56,11 +56,11 @@ def main():
     os.makedirs(out, exist_ok=True)
 
     # Figure 3
-    fig, axes = plt.subplots(2, 2, figsize=(8, 8))
+    fig, axes = plt.subplots(2, 2, figsize=(8, 7.2))
     for col, (case, name) in enumerate([("translation", "sedimentation-like"), ("squirmer", "squirmer")]):
         streamlines(axes[0, col], os.path.join(a.dir, f"plane_{case}_far.csv"), name + ", whole box")
         streamlines(axes[1, col], os.path.join(a.dir, f"plane_{case}_near.csv"), name + ", near field")
-    sm = plt.cm.ScalarMappable(cmap="viridis", norm=matplotlib.colors.Normalize(-5, 0))
+    sm = plt.cm.ScalarMappable(cmap="viridis", norm=matplotlib.colors.Normalize(-7, 0))
     fig.colorbar(sm, ax=axes, shrink=0.6, label="log10 |(u_x, u_y)| on z = 0")
     fig.savefig(os.path.join(out, "sphere_squirmer_streamlines.png"), dpi=80)
     plt.close(fig)

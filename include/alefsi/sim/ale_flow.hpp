@@ -22,8 +22,9 @@
 ///
 /// Rigid bodies (`add_body`): 2D (RigidBody2D, 3 DOF) and 3D (RigidBody3D, 6 DOF, orientation a
 /// unit quaternion), coupled monolithically: a free body's velocities are extra unknowns, its
-/// surface velocity DOFs are linked to them through H (at X^{n+1}), its rows are the
-/// Newton-Euler equations (3D: with the gyroscopic term w x I_w w and its exact Jacobian).
+/// surface velocity DOFs are linked to them through H (at X^{n+theta}, see step_with), its rows
+/// are the Newton-Euler equations (3D: with the gyroscopic term w x I_w w and its exact
+/// Jacobian).
 /// Centre and orientation advance by the scheme's position formula with the extrapolated body
 /// velocity (3D: on the rotation vector relative to q^n, see RigidBodyTraits<3>::advance);
 /// surface nodes follow the exact rigid map. What differs between 2D and 3D is
@@ -784,19 +785,35 @@ class AleFlow {
       const Vec<D> val = dirichlet_.at(tag)(dof_point(i, Xn1), t1);
       for (int k = 0; k < D; ++k) cons_->set_fixed_value(space_->velocity_field(i, k), val[k]);
     }
-    // body surface velocities at t^{n+1} on X^{n+1}: u = H Z + u_s
+    // body surface velocities at t^{n+1} on X^{n+1}: u = H(r^{n+1}) Z + u_s. A free body's link
+    // is also its rows' test function, which must live where the flow is integrated, X^{n+theta}
+    // (else the torque row is off by (r^{n+1} - r^{n+theta}) x F = O(dt) when theta < 1: the
+    // sum of r . F over the surface carries the pressure level). So the link takes
+    // H(r^{n+theta}) and the offset the rest, H(r^{n+1}) - H(r^{n+theta}), times the
+    // Z extrapolated to t^{n+1}: the velocity is off by O(dt^3) only. For theta = 1 both are
+    // H(r^{n+1}).
     for (auto& body : bodies_) {
       const BodyVelocity Zp = body.data.free() ? BodyVelocity::Zero() : BodyVelocity(body.data.prescribed(t1));
+      const Vec<D> xg_th = S::theta * body.xg_next + (1 - S::theta) * body.xg[0];
+      const BodyVelocity Zx = 2 * body.Z[0] - body.Z[1];
       for (Index i : body.dofs) {
         const Vec<D> r = dof_point(i, Xn1) - body.xg_next;
-        const Vec<D> us = body.data.slip ? BodyTraits::to_world(body.data.slip(BodyTraits::to_body(r, body.th_next, body.data)),
-                                                                body.th_next, body.data)
-                                         : Vec<D>::Zero();
+        Vec<D> us = body.data.slip ? BodyTraits::to_world(body.data.slip(BodyTraits::to_body(r, body.th_next, body.data)),
+                                                          body.th_next, body.data)
+                                   : Vec<D>::Zero();
         const auto H = BodyTraits::rows(r);
-        for (int k = 0; k < D; ++k) {
-          const Index f = space_->velocity_field(i, k);
-          if (body.data.free()) cons_->set_link(f, {H[k].data(), std::size_t(body_dofs)}, us[k]);
-          else cons_->set_fixed_value(f, H[k].dot(Zp) + us[k]);
+        if (!body.data.free()) {
+          for (int k = 0; k < D; ++k) cons_->set_fixed_value(space_->velocity_field(i, k), H[k].dot(Zp) + us[k]);
+          continue;
+        }
+        if constexpr (S::theta < 1) {
+          const auto Hth = BodyTraits::rows(Vec<D>(dof_point(i, Xth) - xg_th));
+          for (int k = 0; k < D; ++k) {
+            us[k] += (H[k] - Hth[k]).dot(Zx);
+            cons_->set_link(space_->velocity_field(i, k), {Hth[k].data(), std::size_t(body_dofs)}, us[k]);
+          }
+        } else {
+          for (int k = 0; k < D; ++k) cons_->set_link(space_->velocity_field(i, k), {H[k].data(), std::size_t(body_dofs)}, us[k]);
         }
       }
     }

@@ -3,8 +3,13 @@
 // linked (rigid-body-like) DOFs.
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <map>
+#include <numeric>
 #include <set>
+#include <vector>
 
 #include "alefsi/fem/constraints.hpp"
 #include "alefsi/fem/dofmap.hpp"
@@ -446,4 +451,231 @@ TEST_CASE("Navier-Stokes assembly on two threads is bit-identical to one thread"
   check_ns_threads<2, P1P1Gls>(24);
   check_ns_threads<3, TaylorHood>(6);   // 1296 cells
   check_ns_threads<3, P1P1Gls>(6);
+}
+
+namespace {
+// Checks an assembler's pattern and scatter positions against a reference built directly from
+// the cells and the constraints, with no groups, blocks or classes: the rows of column j are
+// the unknowns of the cells whose unknowns include j (a cell's unknowns: those its field DOFs
+// depend on). Positions: each cell alone scatters a matrix and a residual with distinct
+// entries into zero values, which must receive exactly T_e^T A_e T_e and T_e^T r_e (simple
+// cells: every entry exactly once, so compared exactly), and nothing else (every value is
+// zero again once the expected entries are cleared).
+// Returns the bytes per stored position (1 when all are 8-bit).
+template <int N>
+double check_pattern_and_positions(const std::vector<std::array<Index, N>>& cells, const DofConstraints& cons) {
+  const Index nc = Index(cells.size()), nu = cons.n_unknowns();
+  Assembler<N> asmb(nc, [&](Index c) { return cells[c]; }, cons);
+  std::vector<std::set<Index>> rows(nu);
+  for (const auto& d : cells) {
+    std::set<Index> us;
+    for (Index f : d)
+      for (Index u : cons.indices(f)) us.insert(u);
+    for (Index j : us) rows[j].insert(us.begin(), us.end());
+  }
+  std::size_t nnz = 0;
+  for (const auto& r : rows) nnz += r.size();
+  SparseMatrix M = asmb.matrix();
+  REQUIRE(M.rows() == nu);
+  REQUIRE(M.cols() == nu);
+  REQUIRE(M.isCompressed());
+  REQUIRE(std::size_t(M.nonZeros()) == nnz);
+  REQUIRE(std::size_t(asmb.n_nonzeros()) == nnz);
+  Index bad_columns = 0;
+  for (Index j = 0; j < nu; ++j) {
+    const Index b = M.outerIndexPtr()[j], e = M.outerIndexPtr()[j + 1];
+    bad_columns += std::size_t(e - b) != rows[j].size() || !std::equal(rows[j].begin(), rows[j].end(), M.innerIndexPtr() + b);
+  }
+  CHECK(bad_columns == 0);
+  // a matrix given to assemble receives the same pattern
+  struct Zero {
+    void cell(Index, const Eigen::Matrix<Real, N, 1>&, Eigen::Matrix<Real, N, N>& A, Eigen::Matrix<Real, N, 1>& r) const {
+      A.setZero();
+      r.setZero();
+    }
+  };
+  SparseMatrix J;
+  VecX r;
+  asmb.assemble(Zero{}, VecX::Zero(cons.n_field()), &J, &r);
+  REQUIRE(J.nonZeros() == M.nonZeros());
+  CHECK(std::equal(J.outerIndexPtr(), J.outerIndexPtr() + nu + 1, M.outerIndexPtr()));
+  CHECK(std::equal(J.innerIndexPtr(), J.innerIndexPtr() + J.nonZeros(), M.innerIndexPtr()));
+  // positions, cell by cell
+  std::fill(M.valuePtr(), M.valuePtr() + M.nonZeros(), 0.0);
+  r.setZero();
+  typename Assembler<N>::LocalMat A;
+  typename Assembler<N>::LocalVec re;
+  for (int i = 0; i < N; ++i) {
+    re[i] = 1 + i;
+    for (int j = 0; j < N; ++j) A(i, j) = 1 + i + N * j;
+  }
+  Index bad_values = 0, bad_residuals = 0;
+  for (Index c = 0; c < nc; ++c) {
+    asmb.scatter(c, A, re, M.valuePtr(), &r);
+    std::map<std::pair<Index, Index>, Real> ref;  // (row, column) -> value
+    std::map<Index, Real> rref;
+    bool simple = true;
+    for (int i = 0; i < N; ++i) {
+      const auto ui = cons.indices(cells[c][i]);
+      const auto wi = cons.weights(cells[c][i]);
+      simple &= cons.kind(cells[c][i]) != DofConstraints::Kind::linked;
+      for (std::size_t a = 0; a < ui.size(); ++a) {
+        rref[ui[a]] += wi[a] * re[i];
+        for (int j = 0; j < N; ++j) {
+          const auto uj = cons.indices(cells[c][j]);
+          const auto wj = cons.weights(cells[c][j]);
+          for (std::size_t b = 0; b < uj.size(); ++b) ref[{ui[a], uj[b]}] += wi[a] * wj[b] * A(i, j);
+        }
+      }
+    }
+    const Real tol = simple ? 0.0 : 1e-12;
+    for (const auto& [rc, v] : ref) {
+      Real& m = M.coeffRef(rc.first, rc.second);  // in the pattern (checked above)
+      bad_values += std::abs(m - v) > tol * std::abs(v);
+      m = 0;
+    }
+    for (const auto& [u, v] : rref) {
+      bad_residuals += std::abs(r[u] - v) > tol * std::abs(v);
+      r[u] = 0;
+    }
+  }
+  CHECK(bad_values == 0);
+  CHECK(bad_residuals == 0);
+  CHECK(std::all_of(M.valuePtr(), M.valuePtr() + M.nonZeros(), [](Real v) { return v == 0.0; }));
+  CHECK(r.isZero(0.0));
+  return double(asmb.position_bytes()) / double(asmb.n_positions());
+}
+
+// Rigid-body link of velocity DOF (node x, component k) to the body's extra unknowns
+// z .. z + n (2D: V1, V2, w; 3D: V1, V2, V3, w1, w2, w3): u = V + w x r.
+template <int D>
+void link_rigid(DofConstraints& cons, Index f, const Vec<D>& x, int k, Index z, Real offset) {
+  if constexpr (D == 2) {
+    const Index ex[] = {z, z + 1, z + 2};
+    const Real w[] = {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 0 ? -x[1] : x[0]};
+    cons.link(f, ex, w, offset);
+  } else {
+    const Index ex[] = {z, z + 1, z + 2, z + 3, z + 4, z + 5};
+    Real w[6] = {0, 0, 0, 0, 0, 0};
+    w[k] = 1;
+    // (w x r)_k: k = 0: w2 r3 - w3 r2; k = 1: w3 r1 - w1 r3; k = 2: w1 r2 - w2 r1
+    const int a = (k + 1) % 3, b = (k + 2) % 3;
+    w[3 + a] = x[b];
+    w[3 + b] = -x[a];
+    cons.link(f, ex, w, offset);
+  }
+}
+
+template <int D, class Pair>
+void check_space_pattern(const Mesh<D>& mesh, int linked_tag, int half_fixed_tag, bool linked_region) {
+  using Space = MixedSpace<D, Pair>;
+  Space space(mesh);
+  const auto& vel = space.velocity();
+  DofConstraints cons(space.n_field());
+  const Index z = cons.add_unknowns(D == 2 ? 3 : 6);
+  std::vector<char> done(vel.n_dofs(), 0);
+  for (Index i : vel.boundary_dofs(linked_tag)) {
+    done[i] = 1;
+    for (int k = 0; k < D; ++k) link_rigid<D>(cons, space.velocity_field(i, k), vel.point(i), k, z, 0.01 * k);
+  }
+  if (linked_region)  // a large body: every velocity DOF left of x = 0.7
+    for (Index i = 0; i < vel.n_dofs(); ++i)
+      if (!done[i] && vel.point(i)[0] < 0.7) {
+        done[i] = 1;
+        for (int k = 0; k < D; ++k) link_rigid<D>(cons, space.velocity_field(i, k), vel.point(i), k, z, 0.0);
+      }
+  for (Index i : vel.boundary_dofs(half_fixed_tag))  // one component fixed: blocks of one
+    if (!done[i]) {
+      done[i] = 1;
+      cons.fix(space.velocity_field(i, 1), 0.5);
+    }
+  cons.fix(space.pressure_field(0), 0.0);
+  cons.finalize();
+  std::vector<std::array<Index, Space::n_local>> cells(mesh.n_cells());
+  for (Index c = 0; c < mesh.n_cells(); ++c) cells[c] = space.cell_field_dofs(c);
+  INFO(D << "D " << Pair::name << ", " << mesh.n_cells() << " cells, " << cons.n_unknowns() << " unknowns");
+  const double bytes = check_pattern_and_positions<Space::n_local>(cells, cons);
+  // wider positions in 3D (columns longer than 256) and on the cells of a large body
+  if (D == 3 || linked_region) CHECK(bytes > 1.0);
+}
+}  // namespace
+
+TEMPLATE_TEST_CASE("assembler pattern and positions equal a direct construction", "[la][assembly][pattern][quick]",
+                   TaylorHood, P1P1Gls) {
+  SECTION("2D annulus: inner circle linked to a rigid body, outer circle half fixed") {
+    check_space_pattern<2, TestType>(annulus_mesh(0.3, 1.0, 4, 20), tags::inner, tags::outer, false);
+  }
+  SECTION("3D box: face xmin linked to a rigid body, face ymin half fixed") {
+    check_space_pattern<3, TestType>(box_mesh(3, 3, 3), tags::xmin, tags::ymin, false);
+  }
+  SECTION("2D square with a large body (32-bit positions on its cells)") {
+    check_space_pattern<2, TestType>(rectangle_mesh(100, 100), tags::left, tags::bottom, true);
+  }
+}
+
+TEST_CASE("assembler pattern and positions on random cells: split, reversed and shared node groups",
+          "[la][assembly][pattern][quick]") {
+  // 15 two-DOF "nodes" (field DOFs 2a, 2a + 1) and 6 single DOFs (30 + s); a cell lists two
+  // nodes and two singles in random order, each node's DOFs in random order (reversed or
+  // apart: blocks that do not start at their group's first unknown, groups split over blocks),
+  // some DOFs fixed, some linked to 1 to 3 of 4 extra unknowns
+  std::uint64_t state = 12345;
+  auto next = [&](std::uint64_t m) {  // deterministic LCG, uniform enough in [0, m)
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return (state >> 33) % m;
+  };
+  for (int trial = 0; trial < 40; ++trial) {
+    constexpr int nn = 15, ns = 6, nfield = 2 * nn + ns;
+    std::vector<std::array<Index, 6>> cells;
+    std::vector<int> node_order(nn), single_order(ns);
+    std::iota(node_order.begin(), node_order.end(), 0);
+    std::iota(single_order.begin(), single_order.end(), 0);
+    const int ncells = 12 + int(next(20));
+    for (int c = 0; c < ncells; ++c) {
+      std::array<Index, 6> d{};
+      int nodes[2], singles[2];
+      if (c < 8) {  // the first cells cover every node and single
+        nodes[0] = (2 * c) % nn, nodes[1] = (2 * c + 1) % nn;
+        singles[0] = c % ns, singles[1] = (c + 3) % ns;
+      } else {
+        nodes[0] = int(next(nn));
+        do nodes[1] = int(next(nn)); while (nodes[1] == nodes[0]);
+        singles[0] = int(next(ns));
+        do singles[1] = int(next(ns)); while (singles[1] == singles[0]);
+      }
+      std::vector<Index> items;
+      for (int q = 0; q < 2; ++q) {
+        const bool rev = next(3) == 0;
+        items.push_back(2 * nodes[q] + (rev ? 1 : 0));
+        items.push_back(2 * nodes[q] + (rev ? 0 : 1));
+      }
+      for (int q = 0; q < 2; ++q) items.push_back(2 * nn + singles[q]);
+      if (next(2)) std::swap(items[1], items[2 + int(next(4))]);  // a node's DOFs apart
+      if (next(2)) std::rotate(items.begin(), items.begin() + int(next(6)), items.end());
+      std::copy(items.begin(), items.end(), d.begin());
+      cells.push_back(d);
+    }
+    DofConstraints cons(nfield);
+    const Index z = cons.add_unknowns(4);
+    for (Index f = 0; f < nfield; ++f) {
+      const auto roll = next(10);
+      if (f < 4 || roll < 2) {  // linked (f < 4: every extra unknown is used)
+        std::vector<Index> ex;
+        std::vector<Real> w;
+        const int ne = f < 4 ? 1 : 1 + int(next(3));
+        for (int q = 0; q < ne; ++q) {
+          const Index e = f < 4 ? Index(f) : Index(next(4));
+          if (std::find(ex.begin(), ex.end(), z + e) != ex.end()) continue;
+          ex.push_back(z + e);
+          w.push_back(0.5 + 0.25 * q + 0.125 * f);
+        }
+        cons.link(f, ex, w, 0.1);
+      } else if (roll < 4) {
+        cons.fix(f, 1.0);
+      }
+    }
+    cons.finalize();
+    INFO("trial " << trial);
+    check_pattern_and_positions<6>(cells, cons);
+  }
 }

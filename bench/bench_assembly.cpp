@@ -291,7 +291,7 @@ void bm_pattern(benchmark::State& state, int n) {
   }
   size_counters(state, *p.asmb);
   rate_counters(state, double(p.asmb->n_cells()));
-  state.counters["pos_MB"] = double(p.asmb->n_positions()) * sizeof(Index) / 1048576.0;
+  state.counters["pos_MB"] = double(p.asmb->position_bytes()) / 1048576.0;
   state.counters["matrix_MB"] = double(p.asmb->n_nonzeros()) * (sizeof(Real) + sizeof(Index)) / 1048576.0;
   state.counters["colours"] = double(p.asmb->n_colours());
   state.counters["peak_MB"] = peak_mb();

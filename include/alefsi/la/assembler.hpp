@@ -534,10 +534,11 @@ class Assembler {
     auto positions = [&](Index v) {
       auto put = [&](auto* pj, Index nb, const Block* blk, const Index* red) {
         using P = std::remove_reference_t<decltype(*pj)>;
+        const Index* rk = rank;  // a local: the 8-bit stores may alias anything else
         if (aligned)
-          for (Index I = 0; I < nb; ++I) pj[I] = P(rank[blk[I].col]);
+          for (Index I = 0; I < nb; ++I) pj[I] = P(rk[blk[I].col]);
         else
-          for (Index I = 0; I < nb; ++I) pj[I] = P(rank[red[blk[I].start]]);
+          for (Index I = 0; I < nb; ++I) pj[I] = P(rk[red[blk[I].start]]);
       };
       const Index k1 = gbstart[v + 1];
       for (Index k = gbstart[v]; k < k1; ++k) {

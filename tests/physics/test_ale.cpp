@@ -96,9 +96,8 @@ Real run_mms(int steps, Real T, bool elastic, int n_mesh = 4, Linearisation lin 
   return e.u_l2;
 }
 
-// `at_least`: assert rate >= order - 0.15 only (see the P1/P1-GLS test below).
 template <int D, class Pair, class Scheme>
-void check_order(bool elastic, std::vector<int> steps, Real T = 1.0, int n_mesh = 4, bool at_least = false) {
+void check_order(bool elastic, std::vector<int> steps, Real T = 1.0, int n_mesh = 4) {
   std::vector<Real> err;
   for (int s : steps) err.push_back(run_mms<D, Pair, Scheme>(s, T, elastic, n_mesh));
   std::cout << D << "D " << Pair::name << " " << Scheme::name << (elastic ? " (elastic mesh)" : " (prescribed mesh)")
@@ -111,8 +110,7 @@ void check_order(bool elastic, std::vector<int> steps, Real T = 1.0, int n_mesh 
   std::cout << "\n";
   const std::size_t m = err.size();
   const Real rate = std::log(err[m - 2] / err[m - 1]) / std::log(Real(steps[m - 1]) / steps[m - 2]);
-  if (at_least) CHECK(rate >= Scheme::order - 0.15);
-  else CHECK(rate == Approx(Scheme::order).margin(0.15));
+  CHECK(rate == Approx(Scheme::order).margin(0.15));
 }
 }  // namespace
 
@@ -182,14 +180,22 @@ TEMPLATE_TEST_CASE("2D Taylor-Hood: every scheme reaches its design order in tim
   check_order<2, TaylorHood, TestType>(false, {10, 20, 40, 80});
   check_order<2, TaylorHood, TestType>(true, {10, 20, 40, 80});
 }
-// P1/P1-GLS: MR/AB (2.00) and BDF3 (3.09) sit on their design orders, but BDF2/BDF2E and
-// BDF2/AB measure 2.24 and BSS 1.13 at dt = T/640, with the rates not yet settling (2.37, 2.29,
-// 2.20, 2.19, 2.24 for BDF2/BDF2E). tau contains 2 rho / dt, so the stabilised spatial operator
-// changes with dt; that interaction is not yet understood, so only "at least the design order"
-// is asserted here and the question stays open (issue 4).
-TEMPLATE_TEST_CASE("2D P1/P1-GLS: every scheme reaches at least its design order in time", "[ale][convergence]",
-                   MR_AB, BDF2_BDF2E, BDF2_AB, BDF3_BDF3E, BSS) {
-  check_order<2, P1P1Gls, TestType>(false, {20, 40, 80, 160, 320, 640}, 1.0, 4, true);
+// P1/P1-GLS, on an 8 x 8 mesh. tau = [(2 rho/dt)^2 + ...]^(-1/2) -> dt / (2 rho) as dt -> 0, so
+// the stabilised spatial operator changes with dt: the velocity error at T is dt^p F(tau(dt)),
+// F(tau) the error constant of the same scheme with tau frozen, and the measured rate is
+// p + dlnF/dlntau. (Without the 2 rho/dt term in tau the rates are p +- 0.003 at dt = T/1280 on
+// 4 x 4; there, for BDF2/BDF2E, e N^2 equals F(tau_N) from frozen-tau runs to 3 digits for
+// N = 40..5120.) As tau -> 0 the method tends to Galerkin P1/P1, whose discretely divergence-free
+// interior velocities on this n x n mesh span (n - 3)^2 dimensions. On 4 x 4 the velocity locks:
+// F(tau) ~ tau for tau < 1e-7, the rates of the theta = 1 schemes lie above p and tend to p + 1
+// (BDF2/BDF2E 2.24 at dt = T/640, 2.57 at T/5120; BSS 1.13), so the design order is not the
+// asymptotic rate there. On 8 x 8 (25 dimensions) F(0) != 0 and dlnF/dlntau < 0.06 for
+// tau < 1e-2: every scheme is within 0.06 of its design order at dt = T/320, with the prescribed
+// and with the elastic mesh motion. (MR/AB's F hardly depends on tau: 2.00 on either mesh.)
+TEMPLATE_TEST_CASE("2D P1/P1-GLS: every scheme reaches its design order in time", "[ale][convergence]", MR_AB,
+                   BDF2_BDF2E, BDF2_AB, BDF3_BDF3E, BSS) {
+  check_order<2, P1P1Gls, TestType>(false, {20, 40, 80, 160, 320}, 1.0, 8);
+  check_order<2, P1P1Gls, TestType>(true, {20, 40, 80, 160, 320}, 1.0, 8);
 }
 TEMPLATE_TEST_CASE("3D Taylor-Hood: design order in time", "[ale][convergence]", BDF2_BDF2E, BDF3_BDF3E) {
   check_order<3, TaylorHood, TestType>(false, {10, 20, 40, 80}, 1.0, 2);

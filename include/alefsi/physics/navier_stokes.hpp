@@ -18,7 +18,10 @@
 ///   tau_K = [ (2 rho / dt)^2 + (2 rho |a*| / h_K)^2 + (4 mu / h_K^2)^2 ]^(-1/2),
 /// a* = u* - v at the cell centroid (extrapolated, so tau does not depend on the unknowns and
 /// the Jacobian below is exact), h_K the longest edge. With no convection and dt -> infinity
-/// tau reduces to the Stokes value h^2 / (4 mu).
+/// tau reduces to the Stokes value h^2 / (4 mu); as dt -> 0, tau -> dt / (2 rho), so the
+/// stabilised operator depends on dt and a temporal error is dt^p F(tau(dt)), F the error
+/// constant at frozen tau (measured rates p + dlnF/dlntau; see the P1/P1-GLS temporal-order
+/// test in tests/physics/test_ale.cpp).
 /// `Convection = false` drops every convective term at compile time (unsteady Stokes).
 #include <cmath>
 #include <functional>

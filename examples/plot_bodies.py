@@ -2,11 +2,15 @@
 """Plots the bodies' time series written by alefsi's run driver (DIR/bodies.csv).
 
 usage: python3 examples/plot_bodies.py DIR [DIR2 ...] [--labels a,b,...] [--out PREFIX]
+                                      [--differences] [--spread DIR_A,DIR_B,LABEL ...]
 
 Writes PREFIX_positions.png (x and y of every body against t), PREFIX_velocities.png
 (V1, V2 and w against t) and PREFIX_trajectories.png (the paths in the x-y plane). With
-several folders (e.g. three mesh / dt levels) the curves are overlaid. PREFIX defaults to
-DIR/dkt. Needs matplotlib (Debian: python3-matplotlib).
+several folders (e.g. mesh / dt levels) the curves are overlaid. PREFIX defaults to
+DIR/dkt. With --differences also PREFIX_differences.png: for each pair of successive folders
+the largest distance between the positions of a body in the two runs against t (log scale),
+plus one dashed curve per --spread DIR_A,DIR_B,LABEL (e.g. two runs of one level on
+different initial meshes). Needs matplotlib (Debian: python3-matplotlib).
 """
 import csv
 import sys
@@ -25,11 +29,39 @@ def read(folder):
     return cols, n
 
 
+def distance(a, b):
+    """t and max over bodies of |X_a(t) - X_b(t)|, at the times of run a inside run b's range
+    (b linearly interpolated in t)."""
+    (ca, n), (cb, _) = a, b
+    tb = cb["t"]
+    ts, ds, j = [], [], 0
+    for i, t in enumerate(ca["t"]):
+        if t < tb[0] or t > tb[-1]:
+            continue
+        while j + 1 < len(tb) and tb[j + 1] < t:
+            j += 1
+        k = min(j + 1, len(tb) - 1)
+        w = 0.0 if k == j else (t - tb[j]) / (tb[k] - tb[j])
+        d = 0.0
+        for m in range(n):
+            xb = cb[f"x{m}"][j] + w * (cb[f"x{m}"][k] - cb[f"x{m}"][j])
+            yb = cb[f"y{m}"][j] + w * (cb[f"y{m}"][k] - cb[f"y{m}"][j])
+            d = max(d, ((ca[f"x{m}"][i] - xb) ** 2 + (ca[f"y{m}"][i] - yb) ** 2) ** 0.5)
+        ts.append(t), ds.append(max(d, 1e-12))
+    return ts, ds
+
+
 def main(argv):
-    folders, labels, out = [], None, None
+    folders, labels, out, differences, spreads = [], None, None, False, []
     i = 0
     while i < len(argv):
-        if argv[i] == "--labels":
+        if argv[i] == "--differences":
+            differences = True
+            i += 1
+        elif argv[i] == "--spread":
+            spreads.append(argv[i + 1].split(","))
+            i += 2
+        elif argv[i] == "--labels":
             labels = argv[i + 1].split(",")
             i += 2
         elif argv[i] == "--out":
@@ -78,6 +110,18 @@ def main(argv):
     fig.tight_layout()
     fig.savefig(f"{out}_trajectories.png", dpi=120)
     print(f"wrote {out}_positions.png, {out}_velocities.png, {out}_trajectories.png")
+
+    if differences:
+        fig, ax = plt.subplots(figsize=(6.5, 4))
+        for (a, la), (b, lb) in zip(zip(data, labels), zip(data[1:], labels[1:])):
+            ax.semilogy(*distance(a, b), label=f"{la} -> {lb}")
+        for sp in spreads:
+            ax.semilogy(*distance(read(sp[0]), read(sp[1])), "--", label=sp[2] if len(sp) > 2 else sp[1])
+        ax.set_xlabel("t [s]"), ax.set_ylabel("max over bodies |X_a - X_b| [cm]"), ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(f"{out}_differences.png", dpi=120)
+        print(f"wrote {out}_differences.png")
     return 0
 
 

@@ -30,6 +30,7 @@
 ///     flow3d.add_body(ball);
 #include <array>
 #include <cmath>
+#include <concepts>
 #include <functional>
 #include <numbers>
 #include <string>
@@ -331,6 +332,7 @@ struct RigidBodyTraits;
 template <>
 struct RigidBodyTraits<2> {
   using Body = RigidBody2D;
+  static constexpr int dim = 2;
   static constexpr int n_dof = 3;
   using Velocity = Vec<3>;
   using Orientation = Real;  ///< the angle theta
@@ -366,6 +368,7 @@ struct RigidBodyTraits<2> {
 template <>
 struct RigidBodyTraits<3> {
   using Body = RigidBody3D;
+  static constexpr int dim = 3;
   static constexpr int n_dof = 6;
   using Velocity = Vec<6>;
   using Orientation = Eigen::Quaternion<Real>;  ///< unit, body frame -> world
@@ -422,5 +425,38 @@ struct RigidBodyTraits<3> {
     return J;
   }
 };
+
+
+/// A rigid-body model: what sim/ale_flow.hpp reads from `RigidBodyTraits<D>` to couple a body of
+/// dimension D to the flow. `Body` is the run-time description (tag, mass and inertia, initial
+/// state, slip, optional prescribed motion Z(t)); free and prescribed bodies share it because a
+/// scene mixes them (a driven cylinder beside free particles) and the choice costs one branch
+/// per body per step. A minimal model is RigidBodyTraits<2>; a new one (e.g. a body constrained
+/// to a plane in 3D) is a traits type with these members, checked by this concept.
+///
+///     static_assert(alefsi::RigidBodyModel<alefsi::RigidBodyTraits<3>>);
+template <class T>
+concept RigidBodyModel = requires(const typename T::Body& body, const typename T::Velocity& Z,
+                                  const typename T::Orientation& th, const std::array<typename T::Orientation, 3>& ths,
+                                  const Vec<T::dim>& r, const std::array<Real, 4>& bdf, Real dt, int l, std::size_t index) {
+  requires T::dim == 2 || T::dim == 3;
+  requires T::n_dof == T::dim * (T::dim + 1) / 2;
+  { body.tag } -> std::convertible_to<int>;
+  { body.free() } -> std::same_as<bool>;
+  body.validate(index);
+  { T::initial_orientation(body) } -> std::convertible_to<typename T::Orientation>;
+  { T::initial_offset(r, body) } -> std::convertible_to<Vec<T::dim>>;
+  { T::to_world(r, th, body) } -> std::convertible_to<Vec<T::dim>>;
+  { T::to_body(r, th, body) } -> std::convertible_to<Vec<T::dim>>;
+  { T::rows(r) } -> std::convertible_to<std::array<typename T::Velocity, T::dim>>;
+  { T::velocity(Z, r) } -> std::convertible_to<Vec<T::dim>>;
+  { T::step_back(th, Z, dt) } -> std::convertible_to<typename T::Orientation>;
+  { T::advance(ths, Z, bdf, l, dt) } -> std::convertible_to<typename T::Orientation>;
+  { T::inertia(body, th, Z, Z, dt) } -> std::convertible_to<typename T::Velocity>;
+  { T::inertia_jacobian(body, th, Z, dt, dt) } -> std::convertible_to<Eigen::Matrix<Real, T::n_dof, T::n_dof>>;
+};
+
+static_assert(RigidBodyModel<RigidBodyTraits<2>>, "RigidBodyTraits<2> (3-DOF bodies) must model RigidBodyModel");
+static_assert(RigidBodyModel<RigidBodyTraits<3>>, "RigidBodyTraits<3> (6-DOF bodies) must model RigidBodyModel");
 
 }  // namespace alefsi

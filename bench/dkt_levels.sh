@@ -43,7 +43,7 @@ done
 
 # --- summary from the logs ---------------------------------------------------------------
 python3 - "$out" "$offsets" "$exes" "$levels" <<'EOF'
-import math, re, sys
+import csv, math, re, sys
 out, offsets, exes, levels = sys.argv[1], sys.argv[2].split(), sys.argv[3].split(), sys.argv[4].split()
 
 def parse(base):
@@ -57,6 +57,22 @@ def parse(base):
     for t, x0, y0, x1, y1 in re.findall(
             r"^t = ([0-9.]+): upper \(([-0-9.]+), ([-0-9.]+)\), lower \(([-0-9.]+), ([-0-9.]+)\)", log, re.M):
         r[round(float(t), 3)] = ((float(x0), float(y0)), (float(x1), float(y1)))
+    try:  # full precision from DIR/bodies.csv (the log rounds to 1e-4): the same positions and kiss
+        with open(base + "/bodies.csv") as f:
+            rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+        for row in rows:
+            for t in (0.1, 0.2, 0.3):
+                if abs(row["t"] - t) < 0.5 * row["dt"]:
+                    r[t] = ((row["x0"], row["y0"]), (row["x1"], row["y1"]))
+        g = [(row["t"], math.hypot(row["x0"] - row["x1"], row["y0"] - row["y1"]) - 0.25) for row in rows]
+        for (t0, g0), (t1, g1), (t2, g2) in zip(g, g[1:], g[2:]):  # as examples/dkt.cpp
+            if g1 < 0.125 and g1 <= g0 and g2 > g1:
+                a, b, fa, fb = t1 - t0, t1 - t2, g1 - g0, g1 - g2
+                den = a * fb - b * fa
+                r["kiss"] = t1 - (0.5 * (a * a * fb - b * b * fa) / den if den != 0 else 0)
+                break
+    except (OSError, KeyError, ValueError):
+        pass
     m = re.search(r"in (\d+) steps \((\d+) rejected\), (\d+) remeshes, worst quality ([0-9.]+), smallest gap ([-0-9.e+]+)", log)
     if m:
         r.update(steps=int(m.group(1)), rejected=int(m.group(2)), remeshes=int(m.group(3)),

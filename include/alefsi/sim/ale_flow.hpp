@@ -45,7 +45,11 @@
 ///
 /// Start-up: a scheme that reads past levels the history does not have yet takes MR/AB steps
 /// (self-starting, local error O(dt^3), so BDF3 keeps its order); the very first MR/AB step
-/// takes X^{-1} = X^0 - dt V^0 with V^0 solved on X^0, and U^{-1} = U^0.
+/// takes X^{-1} = X^0 - dt V^0 with V^0 solved on X^0, and U^{-1} = U^0. With
+/// `FlowOptions::damped_start` = m the first step is instead taken by m backward-Euler
+/// substeps (extrapolated for order >= 3; see damped_start_step), which damp the stiff modes
+/// of a non-smooth start (MR/AB = Crank-Nicolson does not); the scheme's own formulas, and its
+/// MR/AB start-up steps if it needs a third level, follow.
 ///
 ///     AleFlow<2, TaylorHood, BDF3_BDF3E> flow(mesh, {.rho = 1, .mu = 0.01});
 ///     flow.set_velocity(tags::top, [](const Vec<2>& x, Real t) { ... });
@@ -83,6 +87,17 @@ struct FlowOptions {
   Linearisation linearisation = Linearisation::newton;
   int max_newton = 25;
   Real newton_tolerance = 1e-10;  ///< on the residual's max norm, relative to its first value (+ absolute 1e-13)
+  /// Damped start (Rannacher's, after Luskin & Rannacher 1982) for a start that is not smooth,
+  /// e.g. an impulsive one. 0 (default): the multistep start-up (MR/AB steps, see AleFlow).
+  /// m (even, 2..64): the first step from t0, and the first after each history restart, is
+  /// taken as m backward-Euler (BSS) substeps of dt/m, which damp the stiff modes that
+  /// Crank-Nicolson (MR/AB) keeps (|R(z)| = (1 + z/m)^-m against 1); for a scheme of design
+  /// order >= 3 it is Richardson-extrapolated, 2 [m substeps of dt/m] - [m/2 substeps of 2dt/m],
+  /// so its local error is O(dt^3) instead of O(dt^2) and BDF3 keeps its order
+  /// (|R(z)| ~ (m/2)^(m/2) / z^(m/2) for large z). The history is then left at t^n and
+  /// t^n + dt (equal spacing dt); a scheme that needs more levels continues with its MR/AB
+  /// start-up steps.
+  int damped_start = 0;
 };
 
 /// Remeshing in the time loop (2D). Trigger: worst cell quality (Mesh::quality) below
@@ -171,6 +186,7 @@ class AleFlow {
   using TimeFunction = std::function<Vec<D>(const Vec<D>&, Real)>;
   /// What differs between 2D and 3D bodies (physics/rigid_body.hpp).
   using BodyTraits = RigidBodyTraits<D>;
+  static_assert(RigidBodyModel<BodyTraits> && BodyTraits::dim == D);
   using BodyData = typename BodyTraits::Body;                 ///< RigidBody2D / RigidBody3D
   using BodyVelocity = typename BodyTraits::Velocity;         ///< Z: Vec<3> (2D) / Vec<6> (3D)
   using BodyOrientation = typename BodyTraits::Orientation;  ///< angle (2D) / unit quaternion (3D)
@@ -180,6 +196,8 @@ class AleFlow {
     ALEFSI_CHECK_ARG(opt.rho >= 0 && std::isfinite(opt.rho), "rho", "fluid density must be >= 0 and finite, got ", opt.rho);
     ALEFSI_CHECK_ARG(opt.mu > 0 && std::isfinite(opt.mu), "mu", "viscosity must be positive and finite, got ", opt.mu);
     ALEFSI_CHECK_ARG(opt.max_newton >= 1, "max_newton", "must be >= 1");
+    ALEFSI_CHECK_ARG(opt.damped_start == 0 || (opt.damped_start >= 2 && opt.damped_start <= 64 && opt.damped_start % 2 == 0),
+                     "damped_start", "must be 0 (off) or an even number of substeps in 2..64, got ", opt.damped_start);
     rebuild_discretisation();
     X_[0] = mesh_.coordinates();
     U_[0] = VecX::Zero(space_->n_field());
@@ -267,12 +285,15 @@ class AleFlow {
       levels_ = 0;
       ++stats_.history_restarts;
     }
-    if (levels_ == 0) {
+    const bool damped = levels_ == 0 && opt_.damped_start > 0;
+    if (levels_ == 0 && !damped) {
       set_body_mesh_velocity(X_[0], {1.0, 0.0, 0.0}, t_);
       Vn_ = solve_mesh_velocity(X_[0], U_[0], t_);
     }
     StepReport rep;
-    if (levels_ < history_levels<Scheme>()) {
+    if (damped) {
+      rep = damped_start_step(dt);
+    } else if (levels_ < history_levels<Scheme>()) {
       rep = step_with<MR_AB>(dt);
       rep.startup = true;
     } else {
@@ -932,6 +953,95 @@ class AleFlow {
     Vec<D> contact = Vec<D>::Zero();           // collision force in the last step
     BodyVelocity data_external() const { return data.external_load; }
   };
+
+  // ---- the damped start (FlowOptions::damped_start) ----
+  // The whole state a step changes, to take a damped start twice (extrapolation) and to leave
+  // the flow at t^n when a substep throws.
+  struct Snapshot {
+    Real t = 0;
+    int levels = 0;
+    std::array<std::vector<Vec<D>>, 3> X;
+    std::array<VecX, 3> U;
+    std::vector<Vec<D>> Vn;
+    std::vector<Body> bodies;
+  };
+  Snapshot snapshot() const { return {t_, levels_, X_, U_, Vn_, bodies_}; }
+  void restore(const Snapshot& s) {
+    t_ = s.t, levels_ = s.levels, X_ = s.X, U_ = s.U, Vn_ = s.Vn, bodies_ = s.bodies;
+    mesh_.set_coordinates(X_[0]);
+  }
+  static void add_report(StepReport& acc, const StepReport& r) {
+    acc.newton_iterations += r.newton_iterations;
+    acc.residuals.insert(acc.residuals.end(), r.residuals.begin(), r.residuals.end());
+    acc.t_mesh_velocity += r.t_mesh_velocity, acc.t_assembly += r.t_assembly, acc.t_factorize += r.t_factorize;
+    acc.t_solve += r.t_solve;
+  }
+  // Orientation extrapolated from two approximations a (error e) and b (error ~2e): 2a - b on
+  // the angle (2D); a (b^-1 a) on the rotation group (3D: a exp(e_a) exp(e_a - e_b) = exp(2 e_a - e_b) to O(e^2)).
+  static BodyOrientation extrapolate_orientation(const BodyOrientation& a, const BodyOrientation& b) {
+    if constexpr (D == 2) return 2 * a - b;
+    else return BodyOrientation(a * (b.inverse() * a)).normalized();
+  }
+
+  // The first step from t^n (levels_ == 0) by m = opt_.damped_start backward-Euler substeps of
+  // dt/m: BSS, the only L-stable scheme of the five (|R(inf)| = 0, where Crank-Nicolson keeps
+  // |R(inf)| = 1), so the stiff modes of a non-smooth start are damped before the multistep
+  // formulas take over. Local error O(dt^2) (m substeps of O((dt/m)^2)): enough for design
+  // order <= 2. For order >= 3 the result is Richardson-extrapolated with m/2 substeps of
+  // 2 dt/m, 2 u_{dt/m} - u_{2dt/m}, local error O(dt^3) (the O(dt^2) terms of the two cancel:
+  // BE's error is c dt_sub + O(dt_sub^2) per unit time); the extrapolation of the stability
+  // functions, 2 (1 + z/m)^-m - (1 + 2z/m)^-(m/2), still vanishes at z -> inf. Positions and
+  // field are extrapolated node by node, the bodies' centre, velocity and orientation likewise
+  // and their surface nodes placed by the exact rigid map. The history is then set to levels
+  // t^n (the state before the step) and t^n + dt, V^n is solved at t^n + dt on X^{n+1} (as at a
+  // history restart) and levels_ = 1: a scheme that reads two past levels (BDF3) takes one
+  // MR/AB start-up step next. A substep that throws leaves the flow at t^n.
+  StepReport damped_start_step(Real dt) {
+    const int m = opt_.damped_start;
+    const Snapshot s0 = snapshot();
+    StepReport rep;
+    rep.startup = true;
+    auto substeps = [&](int count) {
+      for (int j = 0; j < count; ++j) add_report(rep, step_with<BSS>(dt / count));
+    };
+    try {
+      substeps(m);
+      if constexpr (Scheme::order >= 3) {
+        const Snapshot fine = snapshot();
+        restore(s0);
+        substeps(m / 2);
+        for (std::size_t i = 0; i < X_[0].size(); ++i) X_[0][i] = 2 * fine.X[0][i] - X_[0][i];
+        U_[0] = 2 * fine.U[0] - U_[0];
+        for (std::size_t k = 0; k < bodies_.size(); ++k) {
+          Body& b = bodies_[k];
+          const Body& f = fine.bodies[k];
+          b.xg[0] = 2 * f.xg[0] - b.xg[0];
+          b.Z[0] = 2 * f.Z[0] - b.Z[0];
+          b.th[0] = extrapolate_orientation(f.th[0], b.th[0]);
+          b.load = f.load, b.contact = f.contact;
+          for (std::size_t j = 0; j < b.nodes.size(); ++j)
+            X_[0][b.nodes[j]] = b.xg[0] + BodyTraits::to_world(b.r0[j], b.th[0], b.data);
+        }
+      }
+      // the history at t^n and t^n + dt (level 2 is not read with levels_ = 1; it holds t^n too)
+      for (int k = 1; k < 3; ++k) X_[k] = s0.X[0], U_[k] = s0.U[0];
+      for (std::size_t i = 0; i < bodies_.size(); ++i)
+        for (int k = 1; k < 3; ++k) {
+          bodies_[i].xg[k] = s0.bodies[i].xg[0];
+          bodies_[i].th[k] = s0.bodies[i].th[0];
+          bodies_[i].Z[k] = s0.bodies[i].Z[0];
+        }
+      t_ = s0.t + dt;
+      levels_ = 1;
+      mesh_.set_coordinates(X_[0]);
+      set_body_mesh_velocity(X_[0], {1.0, 0.0, 0.0}, t_);
+      Vn_ = solve_mesh_velocity(X_[0], U_[0], t_);
+    } catch (...) {
+      restore(s0);
+      throw;
+    }
+    return rep;
+  }
 
   // M delta_l Z^{n+1} / dt (+ w x I_w w in 3D) for body b, at its orientation for t^{n+1}.
   template <TimeScheme S>

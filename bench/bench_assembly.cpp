@@ -7,8 +7,15 @@
 //   build/bench/bench/bench_assembly --benchmark_filter='P2P1/2D/(kernel|assemble)/512/'
 //
 // Benchmarks (N = cells per side of rectangle_mesh / box_mesh):
-//   <pair>/<D>D/pattern/N    Assembler construction (cell DOF copy + CSR pattern + positions + schedule;
-//                            no value array: the matrix gets the pattern at its first assembly)
+//   <pair>/<D>D/pattern/N    what a user pays before the first fill: Assembler construction (cell DOF
+//                            copy, pattern by node groups, positions, schedule) + take_pattern into a new
+//                            matrix (its row indices written, its values allocated); the previous
+//                            assembler and matrix are released outside the timing. Counters: ctor_ms,
+//                            take_ms (CPU per iteration), faults (minor page faults per iteration),
+//                            first_fill_ms and fill_ms (CPU of the first Stokes assembly into the new
+//                            matrix, which first touches its values, and of a second one)
+//   <pair>/<D>D/repattern/N  the same with Assembler::rebuild and take_pattern into the previous matrix
+//                            (a remesh that reuses the previous pattern's memory)
 //   <pair>/<D>D/kernel/N     gather + StokesKernel::cell over all cells, no scatter
 //   <pair>/<D>D/kernel_quad/N  the same with StokesQuadratureKernel (the former kernel, for reference)
 //   <pair>/<D>D/scatter/N    Assembler::scatter of one fixed element matrix/residual for every cell
@@ -37,6 +44,7 @@
 #include <benchmark/benchmark.h>
 
 #include <malloc.h>
+#include <sys/resource.h>
 #include <time.h>
 
 #include <chrono>
@@ -279,22 +287,72 @@ void rate_counters(benchmark::State& state, double cells_per_iteration, double f
   }
 }
 
+double process_cpu_s() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+long minor_faults() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_minflt;
+}
+
+// Assembler::rebuild (absent before it was added: the benchmark also builds against older headers)
+template <class A>
+concept HasRebuild = requires(A& a, Index n, typename A::CellDofs (*f)(Index), const DofConstraints& c) {
+  a.rebuild(n, f, c);
+};
+
+// pattern (rebuild = false) or repattern (rebuild = true), see the header
 template <int D, class Pair>
-void bm_pattern(benchmark::State& state, int n) {
+void bm_pattern(benchmark::State& state, int n, bool rebuild) {
   auto& p = problem<D, Pair>(n);
-  for (auto _ : state) {
-    state.PauseTiming();
-    p.asmb.reset();  // release the previous pattern outside the timing
-    state.ResumeTiming();
-    p.asmb = p.build_assembler();
-    benchmark::DoNotOptimize(p.asmb.get());
+  SparseMatrix J;
+  if (rebuild) {
+    p.assembler().take_pattern(J);
+    std::fill(J.valuePtr(), J.valuePtr() + J.nonZeros(), Real(0));
   }
+  double ctor = 0, take = 0;
+  long faults = 0;
+  for (auto _ : state) {
+    if (!rebuild) {
+      state.PauseTiming();
+      p.asmb.reset();  // release the previous pattern and matrix outside the timing
+      J = SparseMatrix();
+      state.ResumeTiming();
+    }
+    const double c0 = process_cpu_s();
+    const long f0 = minor_faults();
+    if constexpr (HasRebuild<typename Problem<D, Pair>::Asm>) {
+      if (rebuild) p.asmb->rebuild(p.mesh.n_cells(), [&](Index c) { return p.space.cell_field_dofs(c); }, p.cons);
+    }
+    if (!rebuild) p.asmb = p.build_assembler();
+    const double c1 = process_cpu_s();
+    p.asmb->take_pattern(J);
+    benchmark::DoNotOptimize(J.innerIndexPtr());
+    ctor += c1 - c0;
+    take += process_cpu_s() - c1;
+    faults += minor_faults() - f0;
+  }
+  const double it = double(state.iterations());
   size_counters(state, *p.asmb);
   rate_counters(state, double(p.asmb->n_cells()));
+  state.counters["ctor_ms"] = 1e3 * ctor / it;
+  state.counters["take_ms"] = 1e3 * take / it;
+  state.counters["faults"] = double(faults) / it;
   state.counters["pos_MB"] = double(p.asmb->position_bytes()) / 1048576.0;
   state.counters["matrix_MB"] = double(p.asmb->n_nonzeros()) * (sizeof(Real) + sizeof(Index)) / 1048576.0;
   state.counters["colours"] = double(p.asmb->n_colours());
-  state.counters["peak_MB"] = peak_mb();
+  state.counters["peak_MB"] = peak_mb();  // before the fills below
+  // the first fill into the new matrix (its values first touched) and a second one
+  VecX r;
+  const double c0 = process_cpu_s();
+  p.asmb->assemble(p.kernel, p.field, &J, &r);
+  const double c1 = process_cpu_s();
+  p.asmb->assemble(p.kernel, p.field, &J, &r);
+  state.counters["first_fill_ms"] = 1e3 * (c1 - c0);
+  state.counters["fill_ms"] = 1e3 * (process_cpu_s() - c1);
 }
 
 // which kernel a benchmark runs
@@ -455,7 +513,8 @@ void register_assembly(const std::vector<int>& sizes) {
   for (int n : sizes) {
     std::string s = "/";  // (not "/" + to_string: GCC 12 -O3 false -Wrestrict)
     s += std::to_string(n);
-    reg(base + "pattern" + s, bm_pattern<D, Pair>, n);
+    reg(base + "pattern" + s, bm_pattern<D, Pair>, n, false);
+    if constexpr (HasRebuild<typename Problem<D, Pair>::Asm>) reg(base + "repattern" + s, bm_pattern<D, Pair>, n, true);
     reg(base + "kernel" + s, bm_kernel<D, Pair, Which::stokes>, n);
     reg(base + "kernel_quad" + s, bm_kernel<D, Pair, Which::stokes_quad>, n);
     reg(base + "scatter" + s, bm_scatter<D, Pair>, n);

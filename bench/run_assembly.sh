@@ -7,7 +7,8 @@
 #   bench/run_assembly.sh ns         # Navier-Stokes Jacobian: ns_newton(_kernel|_t2), ns_semi, 2D and 3D
 #   bench/run_assembly.sh threads    # 1 against 2 threads: assemble(_t2), ns_newton(_t2), 2D and 3D
 #                                    # (needs an idle machine to mean anything: see the load printed)
-#   bench/run_assembly.sh pattern    # pattern build next to one assembly (the fill), 2D and 3D
+#   bench/run_assembly.sh pattern    # pattern build (constructor + take_pattern; and the rebuild after a
+#                                    # remesh, repattern) next to one assembly (the fill), 2D and 3D
 #   bench/run_assembly.sh lu         # SparseLU, all but the two long cases (~2 min)
 #   bench/run_assembly.sh lu-long    # 2D P2/P1 N = 256 (COLAMD) and 3D P2/P1 N = 12 (~6 min, 9.5 GB peak)
 #   bench/run_assembly.sh all
@@ -63,7 +64,7 @@ PY
 stokes='/(pattern|kernel|kernel_quad|scatter|assemble|assemble_t2)/'
 ns='/(ns_newton|ns_newton_kernel|ns_newton_kernel_quad|ns_newton_t2|ns_semi)/'
 threads='/(assemble|assemble_t2|ns_newton|ns_newton_t2)/'
-pattern='/(pattern|assemble)/'
+pattern='/(pattern|repattern|assemble)/'
 lu='P2P1/2D/lu_colamd/(16|32|64|128)/|/lu_amd/|P1P1GLS/2D/lu_colamd/|P2P1/3D/lu_colamd/(4|6|8|10)/|P1P1GLS/3D/lu_colamd/'
 lu_long='P2P1/2D/lu_colamd/256/|P2P1/3D/lu_colamd/12/'
 extra=${2:-}

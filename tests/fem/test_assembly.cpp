@@ -679,3 +679,144 @@ TEST_CASE("assembler pattern and positions on random cells: split, reversed and 
     check_pattern_and_positions<6>(cells, cons);
   }
 }
+
+namespace {
+template <int N>
+struct CheapKernel {  // deterministic, cell-dependent, non-symmetric; no transcendental calls
+  void cell(Index c, const Eigen::Matrix<Real, N, 1>& u, Eigen::Matrix<Real, N, N>& A, Eigen::Matrix<Real, N, 1>& r) const {
+    for (int j = 0; j < N; ++j)
+      for (int i = 0; i < N; ++i) A(i, j) = Real((7 * c + 3 * i + 5 * j * j) % 11) - 5 + 0.125 * i;
+    r = A * u;
+    for (int i = 0; i < N; ++i) r[i] += Real((c + i) % 5);
+  }
+};
+
+// A 2D P2/P1 problem: the inner circle of an annulus linked to a rigid body (linked cells),
+// or the unit square cut into 2 n^2 triangles with the left side fixed (large enough at
+// n = 150 for arrays of 4 MB and more, mapped on their own: the blocks, the row groups)
+struct RebuildProblem {
+  using Space = MixedSpace<2, TaylorHood>;
+  Mesh<2> mesh;
+  Space space;
+  DofConstraints cons;
+  explicit RebuildProblem(Mesh<2> m, bool body) : mesh(std::move(m)), space(mesh), cons(space.n_field()) {
+    const auto& vel = space.velocity();
+    if (body) {
+      const Index z = cons.add_unknowns(3);
+      for (Index i : vel.boundary_dofs(tags::inner))
+        for (int k = 0; k < 2; ++k) link_rigid<2>(cons, space.velocity_field(i, k), vel.point(i), k, z, 0.01 * k);
+      for (Index i : vel.boundary_dofs(tags::outer)) cons.fix(space.velocity_field(i, 0), 0.5);
+    } else {
+      for (Index i : vel.boundary_dofs(tags::left))
+        for (int k = 0; k < 2; ++k) cons.fix(space.velocity_field(i, k), 0.25 * k);
+    }
+    cons.fix(space.pressure_field(0), 0.0);
+    cons.finalize();
+  }
+  auto dofs() const {
+    return [this](Index c) { return space.cell_field_dofs(c); };
+  }
+};
+
+// `rebuilt` (after rebuild) against a new assembler on the same problem: the same structure,
+// pattern, positions, schedule, and bit-identical assembled values on one and two threads.
+// J: a matrix that had the previous pattern (given the new one through assemble).
+void check_rebuilt(Assembler<RebuildProblem::Space::n_local>& rebuilt, const RebuildProblem& p, SparseMatrix& J) {
+  constexpr int N = RebuildProblem::Space::n_local;
+  Assembler<N> fresh(p.mesh.n_cells(), p.dofs(), p.cons);
+  CHECK(rebuilt.n_cells() == fresh.n_cells());
+  CHECK(rebuilt.n_unknowns() == fresh.n_unknowns());
+  CHECK(rebuilt.n_nonzeros() == fresh.n_nonzeros());
+  CHECK(rebuilt.n_positions() == fresh.n_positions());
+  CHECK(rebuilt.position_bytes() == fresh.position_bytes());
+  CHECK(rebuilt.n_colours() == fresh.n_colours());
+  CHECK(rebuilt.n_linked_cells() == fresh.n_linked_cells());
+  const SparseMatrix& M = fresh.matrix();
+  const SparseMatrix& R = rebuilt.matrix();  // built anew for the new pattern
+  REQUIRE(R.nonZeros() == M.nonZeros());
+  CHECK(std::equal(R.outerIndexPtr(), R.outerIndexPtr() + M.outerSize() + 1, M.outerIndexPtr()));
+  CHECK(std::equal(R.innerIndexPtr(), R.innerIndexPtr() + M.nonZeros(), M.innerIndexPtr()));
+  VecX field(p.space.n_field());
+  for (Index f = 0; f < field.size(); ++f) field[f] = std::sin(0.3 * f);
+  SparseMatrix Jf;
+  VecX rf, r;
+  fresh.assemble(CheapKernel<N>{}, field, &Jf, &rf);
+  for (int t : {1, 2}) {
+    rebuilt.set_threads(t);
+    rebuilt.assemble(CheapKernel<N>{}, field, &J, &r);
+    REQUIRE(J.nonZeros() == Jf.nonZeros());
+    CHECK(std::equal(J.innerIndexPtr(), J.innerIndexPtr() + J.nonZeros(), Jf.innerIndexPtr()));
+    CHECK(std::equal(J.valuePtr(), J.valuePtr() + J.nonZeros(), Jf.valuePtr()));
+    CHECK(std::equal(r.data(), r.data() + r.size(), rf.data()));
+  }
+  rebuilt.set_threads(1);
+}
+}  // namespace
+
+TEST_CASE("Assembler::rebuild gives what a new assembler gives, and keeps its and the matrix's storage",
+          "[la][assembly][pattern][quick]") {
+  const RebuildProblem annulus(annulus_mesh(0.3, 1.0, 6, 40), true), square(rectangle_mesh(150, 150), false);
+  Assembler<RebuildProblem::Space::n_local> asmb(annulus.mesh.n_cells(), annulus.dofs(), annulus.cons);
+  SparseMatrix J;
+  asmb.take_pattern(J);
+  // larger (fresh arrays), smaller (the larger ones reused), larger again (reused)
+  asmb.rebuild(square.mesh.n_cells(), square.dofs(), square.cons);
+  check_rebuilt(asmb, square, J);
+  const Index* inner = J.innerIndexPtr();
+  const Real* values = J.valuePtr();
+  asmb.rebuild(annulus.mesh.n_cells(), annulus.dofs(), annulus.cons);
+  check_rebuilt(asmb, annulus, J);
+  asmb.rebuild(square.mesh.n_cells(), square.dofs(), square.cons);
+  check_rebuilt(asmb, square, J);
+  // the matrix took the smaller pattern and the larger again in its storage
+  CHECK(J.innerIndexPtr() == inner);
+  CHECK(J.valuePtr() == values);
+  // take_pattern into a matrix large enough keeps its storage too
+  asmb.take_pattern(J);
+  CHECK(J.innerIndexPtr() == inner);
+}
+
+TEST_CASE("detail::UninitArray: sizes, kept contents, storage reuse, on the heap and mapped", "[la][quick]") {
+  // 1000 ints come from the heap, 3 M (12 MB) are mapped on their own
+  for (std::size_t n : {std::size_t(1000), std::size_t(3) << 20}) {
+    INFO(n << " ints");
+    detail::UninitArray<Index> a;
+    CHECK(a.empty());
+    Index* p = a.resize_for_overwrite(n);
+    REQUIRE(a.size() == n);
+    std::iota(p, p + n, 0);
+    auto is_iota = [&](std::size_t m) {  // a[i] == i for i < m
+      bool ok = true;
+      for (std::size_t i = 0; i < m; ++i) ok &= a[i] == Index(i);
+      return ok;
+    };
+    // larger, contents kept (the 1000 go from the heap to a mapping)
+    a.resize_keep(4 * n);
+    REQUIRE(a.size() == 4 * n);
+    CHECK(is_iota(n));
+    std::iota(a.begin(), a.end(), 0);
+    const Index* q = a.data();
+    // smaller, then larger within the capacity: the storage is kept (and the values)
+    CHECK(a.resize_for_overwrite(n) == q);
+    a.resize_keep(2 * n);
+    CHECK(a.data() == q);
+    CHECK(is_iota(n));
+    // larger than the capacity: new storage, contents kept
+    a.resize_keep(8 * n);
+    CHECK(is_iota(n));
+#if defined(__linux__)
+    if (n * sizeof(Index) >= detail::huge_array_bytes)  // mapped on 2 MB boundaries
+      CHECK(reinterpret_cast<std::uintptr_t>(a.data()) % detail::huge_page_bytes == 0);
+#endif
+    a.assign(n, 7);
+    CHECK(std::all_of(a.begin(), a.end(), [](Index v) { return v == 7; }));
+    detail::UninitArray<Index> b(std::move(a));
+    CHECK(a.empty());
+    CHECK(b.size() == n);
+    CHECK(b[n - 1] == 7);
+    a = std::move(b);
+    CHECK(a.size() == n);
+    a.clear();
+    CHECK(a.empty());
+  }
+}

@@ -37,6 +37,17 @@
 /// thread count: results are bit-identical for any t (and equal to round-off to a plain loop
 /// over the cells). The kernel's `cell` is then called concurrently and must be safe to call so.
 ///
+/// Memory. The build is bound by memory touched for the first time as much as by its work:
+/// a fresh page costs a page fault and the kernel's clearing (on the VM of docs/performance.md
+/// ~10 us per 4 KB page, as much as the build's own work on it). So every array is allocated
+/// once, at its size or at a bound whose untouched tail costs nothing, and never zeroed when
+/// it is written in full anyway (`detail::UninitArray`); arrays of 4 MB and more are mapped
+/// 2 MB-aligned with transparent huge pages requested (Linux, `madvise`: one fault per 2 MB),
+/// and so are the row indices and values of a matrix given the pattern (their ends, outside
+/// whole huge pages, are faulted in by one call). `rebuild` (after a remesh) reuses the
+/// previous pattern's arrays, and `take_pattern` / `assemble` reuse a matrix's storage when it
+/// is large enough, so that a rebuild touches no fresh memory.
+///
 /// The kernel is called as `kernel.cell(c, u_e, A_e, r_e)` with the cell's local field values
 /// u_e (constraint offsets included) and must fill the local Jacobian A_e and residual r_e,
 /// both of the compile-time size `N` (the space's local field DOFs).
@@ -44,6 +55,7 @@
 ///     Assembler<Space::n_local> asmb(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
 ///     asmb.set_threads(2);                    // optional
 ///     asmb.assemble(kernel, field, &J, &r);   // J: asmb.matrix() shape, r: n_unknowns
+///     asmb.rebuild(mesh.n_cells(), ..., cons); asmb.take_pattern(J);  // after a remesh
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -62,6 +74,11 @@
 #include <utility>
 #include <vector>
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
+
 #include "alefsi/core/eigen_sparse.hpp"
 #include "alefsi/core/error.hpp"
 #include "alefsi/fem/constraints.hpp"
@@ -69,6 +86,152 @@
 namespace alefsi {
 
 using SparseMatrix = Eigen::SparseMatrix<Real, Eigen::ColMajor, Index>;
+
+namespace detail {
+
+/// Arrays of at least this many bytes are mapped on their own with transparent huge pages
+/// requested (Linux), smaller ones come from the heap.
+inline constexpr std::size_t huge_array_bytes = std::size_t(4) << 20;
+inline constexpr std::size_t huge_page_bytes = std::size_t(2) << 20;
+
+/// Asks the kernel to back the whole pages of [p, p + bytes) with transparent huge pages when
+/// they are first touched (Linux with THP in "madvise" or "always" mode; elsewhere nothing).
+/// Only worth it before the first touch.
+inline void advise_huge_pages([[maybe_unused]] void* p, [[maybe_unused]] std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  if (bytes < huge_array_bytes) return;
+  const auto page = std::uintptr_t(sysconf(_SC_PAGESIZE));
+  const auto a = reinterpret_cast<std::uintptr_t>(p);
+  const std::uintptr_t b = (a + page - 1) / page * page, e = (a + bytes) / page * page;
+  if (e <= b) return;
+  madvise(reinterpret_cast<void*>(b), e - b, MADV_HUGEPAGE);  // advice only: errors ignored
+#if defined(MADV_POPULATE_WRITE)
+  // the ends outside whole huge pages stay 4 KB pages: faulted in by one call each rather
+  // than one fault per page
+  const std::uintptr_t hb = (b + huge_page_bytes - 1) / huge_page_bytes * huge_page_bytes;
+  const std::uintptr_t he = e / huge_page_bytes * huge_page_bytes;
+  if (hb >= he) {
+    madvise(reinterpret_cast<void*>(b), e - b, MADV_POPULATE_WRITE);
+    return;
+  }
+  if (hb > b) madvise(reinterpret_cast<void*>(b), hb - b, MADV_POPULATE_WRITE);
+  if (e > he) madvise(reinterpret_cast<void*>(he), e - he, MADV_POPULATE_WRITE);
+#endif
+#endif
+}
+
+/// A fixed-size array of a trivial type whose elements are not initialised (every array of
+/// the pattern build is written in full before it is read). Large arrays are mapped 2 MB
+/// aligned with transparent huge pages requested (see the file comment: first-touch page
+/// faults were the largest part of the build); `resize_for_overwrite` keeps the storage when
+/// it is large enough.
+template <class T>
+class UninitArray {
+  static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
+
+ public:
+  UninitArray() = default;
+  UninitArray(const UninitArray&) = delete;
+  UninitArray& operator=(const UninitArray&) = delete;
+  UninitArray(UninitArray&& o) noexcept { swap(o); }
+  UninitArray& operator=(UninitArray&& o) noexcept {
+    UninitArray t(std::move(o));
+    swap(t);
+    return *this;
+  }
+  ~UninitArray() { release(); }
+
+  /// n elements of unspecified value.
+  T* resize_for_overwrite(std::size_t n) {
+    if (n > cap_) {
+      release();
+      acquire(n);
+    }
+    n_ = n;
+    return p_;
+  }
+  T* assign(std::size_t n, const T& v) {
+    std::fill_n(resize_for_overwrite(n), n, v);
+    return p_;
+  }
+  /// n elements, the first min(n, size()) kept.
+  T* resize_keep(std::size_t n) {
+    if (n > cap_) {
+      UninitArray t;
+      t.acquire(n);
+      std::copy(p_, p_ + std::min(n, n_), t.p_);
+      swap(t);
+    }
+    n_ = n;
+    return p_;
+  }
+  void clear() {
+    release();
+    n_ = 0;
+  }
+
+  std::size_t size() const { return n_; }
+  bool empty() const { return n_ == 0; }
+  T* data() { return p_; }
+  const T* data() const { return p_; }
+  T& operator[](std::size_t i) { return p_[i]; }
+  const T& operator[](std::size_t i) const { return p_[i]; }
+  T* begin() { return p_; }
+  T* end() { return p_ + n_; }
+  const T* begin() const { return p_; }
+  const T* end() const { return p_ + n_; }
+  const T& back() const { return p_[n_ - 1]; }
+
+ private:
+  void swap(UninitArray& o) noexcept {
+    std::swap(p_, o.p_);
+    std::swap(n_, o.n_);
+    std::swap(cap_, o.cap_);
+    std::swap(mapped_, o.mapped_);
+  }
+  void acquire(std::size_t n) {
+    const std::size_t bytes = n * sizeof(T);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    if (bytes >= huge_array_bytes) {
+      // map 2 MB more than the rounded size, keep a 2 MB-aligned run of it
+      const std::size_t len = (bytes + huge_page_bytes - 1) / huge_page_bytes * huge_page_bytes;
+      void* m = mmap(nullptr, len + huge_page_bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+      if (m == MAP_FAILED) throw std::bad_alloc();
+      const auto a = reinterpret_cast<std::uintptr_t>(m);
+      const std::uintptr_t b = (a + huge_page_bytes - 1) / huge_page_bytes * huge_page_bytes;
+      if (b > a) munmap(m, b - a);
+      if (a + huge_page_bytes > b) munmap(reinterpret_cast<void*>(b + len), a + huge_page_bytes - b);
+      madvise(reinterpret_cast<void*>(b), len, MADV_HUGEPAGE);
+      p_ = reinterpret_cast<T*>(b);
+      cap_ = len / sizeof(T);
+      mapped_ = len;
+      return;
+    }
+#endif
+    p_ = n ? static_cast<T*>(::operator new(bytes)) : nullptr;
+    cap_ = n;
+    mapped_ = 0;
+  }
+  void release() {
+    if (!p_) return;
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    if (mapped_) {
+      munmap(p_, mapped_);
+      p_ = nullptr;
+      cap_ = 0;
+      return;
+    }
+#endif
+    ::operator delete(p_);
+    p_ = nullptr;
+    cap_ = 0;
+  }
+
+  T* p_ = nullptr;
+  std::size_t n_ = 0, cap_ = 0, mapped_ = 0;
+};
+
+}  // namespace detail
 
 /// A cell kernel of N local field DOFs: fills the element Jacobian and residual.
 template <class K, int N>
@@ -92,10 +255,21 @@ class Assembler {
   template <class CellDofsFn>
   Assembler(Index n_cells, CellDofsFn&& cell_dofs, const DofConstraints& cons) : cons_(&cons) {
     if (!cons.finalized()) throw Error("Assembler: DofConstraints must be finalized first");
-    build_local_unknowns(n_cells, cell_dofs);
-    std::vector<std::uint32_t> scratch;
-    build_pattern(scratch);
-    build_schedule(scratch);
+    build(n_cells, cell_dofs);
+  }
+
+  /// Rebuilds for new cells and constraints (after a remesh): the same as a new
+  /// `Assembler(n_cells, cell_dofs, cons)` (the thread count is kept), but the arrays of the
+  /// previous pattern are reused where they are large enough, so that the build does not pay
+  /// for fresh memory (see the file comment). A matrix that took the previous pattern must
+  /// take the new one (`take_pattern`: it reuses the matrix's storage too). If it throws,
+  /// the assembler may only be rebuilt or destroyed.
+  template <class CellDofsFn>
+  void rebuild(Index n_cells, CellDofsFn&& cell_dofs, const DofConstraints& cons) {
+    if (!cons.finalized()) throw Error("Assembler: DofConstraints must be finalized first");
+    cons_ = &cons;
+    matrix_built_ = false;
+    build(n_cells, cell_dofs);
   }
 
   Index n_unknowns() const { return cons_->n_unknowns(); }
@@ -223,19 +397,16 @@ class Assembler {
   /// uninitialised.
   void take_pattern(SparseMatrix& M) const {
     const Index n = n_unknowns();
+    const std::size_t nnz = std::size_t(n_nonzeros());
+    const Index* old_inner = M.innerIndexPtr();
+    const Real* old_values = M.valuePtr();
     M.resize(n, n);
-    M.resizeNonZeros(n_nonzeros());
+    M.resizeNonZeros(Index(nnz));
+    // fresh storage (not the matrix's previous one): huge pages before the first touch
+    if (M.innerIndexPtr() != old_inner) detail::advise_huge_pages(M.innerIndexPtr(), nnz * sizeof(Index));
+    if (M.valuePtr() != old_values) detail::advise_huge_pages(M.valuePtr(), nnz * sizeof(Real));
     std::copy(outer_.begin(), outer_.end(), M.outerIndexPtr());
-    Index* inner = M.innerIndexPtr();
-    const Index ng = Index(gfirst_.size()) - 1;
-    for (Index g = 0; g < ng; ++g) {  // the first column of the group, copied to the others
-      const Index u0 = gfirst_[g], len = outer_[u0 + 1] - outer_[u0];
-      Index* col = inner + outer_[u0];
-      const Index* x = gadj_.get() + gadj_at_[g];
-      for (Index k = 0; k < len; ++x)
-        for (Index u = gfirst_[*x]; u < gfirst_[*x + 1]; ++u) col[k++] = u;
-      for (Index t = 1; t < gfirst_[g + 1] - u0; ++t) std::copy(col, col + len, col + t * len);
-    }
+    expand_rows(M.innerIndexPtr());
   }
 
   /// Scatters one element's Jacobian/residual (exposed for benchmarks and custom loops).
@@ -250,7 +421,8 @@ class Assembler {
     }
     // linked cell: Ar = T_e^T A T_e on the cell's m distinct unknowns
     const Index m = red_start_[c + 1] - red_start_[c];
-    const Index* ent = &ent_[ent_start_[c]];  // per local DOF entry: reduced index
+    const auto li = std::lower_bound(linked_cells_.begin(), linked_cells_.end(), c) - linked_cells_.begin();
+    const Index* ent = &ent_[ent_start_[li]];  // per local DOF entry: reduced index
     MatX Ar = MatX::Zero(m, m);
     VecX rr = VecX::Zero(m);
     std::array<Index, N + 1> es;
@@ -275,6 +447,28 @@ class Assembler {
 
  private:
   struct Aborted {};
+  // The row indices from the rows by groups: every column of a group gets the same rows.
+  void expand_rows(Index* inner) const {
+    const Index ng = Index(gfirst_.size()) - 1;
+    const Index* gf = gfirst_.data();
+    for (Index g = 0; g < ng; ++g) {
+      const Index u0 = gf[g], len = outer_[u0 + 1] - outer_[u0], sg = gf[g + 1] - u0;
+      Index* col = inner + outer_[u0];
+      const Index* x = gadj_.data() + gadj_at_[g];
+      if (sg == 1) {
+        for (Index k = 0; k < len; ++x)
+          for (Index u = gf[*x]; u < gf[*x + 1]; ++u) col[k++] = u;
+      } else if (sg == 2) {
+        for (Index k = 0; k < len; ++x)
+          for (Index u = gf[*x]; u < gf[*x + 1]; ++u, ++k) col[k] = col[len + k] = u;
+      } else {
+        for (Index k = 0; k < len; ++x)
+          for (Index u = gf[*x]; u < gf[*x + 1]; ++u, ++k)
+            for (Index t = 0; t < sg; ++t) col[t * len + k] = u;
+      }
+    }
+  }
+
   /// A run of local unknowns [start, start + size) of one cell; `col`: the start of the
   /// block's first column in the CSR/CSC storage, `stride`: the length of each of its columns
   /// (consecutive columns of a block are that far apart).
@@ -341,114 +535,158 @@ class Assembler {
       for (int s = 0; s < SI; ++s) v[t * stride + s] += a[t * lda + s];
   }
 
+  // ---- pattern build ----------------------------------------------------------------------
+  // Passes: the cells' unknowns (and the cells touching each unknown, counted); the node
+  // groups; the cells' blocks; the incidences (the blocks of each group) with the position
+  // widths; one visit per class (rows and positions); the column starts; the thread schedule.
+  // Every array is written in full before it is read (no zeroing pass where none is needed),
+  // allocated once at its size or a bound (an untouched tail takes no memory), large ones with
+  // transparent huge pages requested (UninitArray).
+  // per group during the build: the visit stamp, the rank (offset of the group's rows in the
+  // columns being visited), the size (unknowns), the column length (a bound, then -1 until
+  // visited, then the length)
+  struct GroupState {
+    Index stamp, rank, size, len;
+  };
+  struct Scratch {
+    detail::UninitArray<Index> gid;          // per unknown: its group; then cursors, ranks
+    detail::UninitArray<Index> gbstart;      // per group: its first incidence
+    detail::UninitArray<GroupState> gs;      // per group
+    detail::UninitArray<Index> bg;           // per block: its group
+    detail::UninitArray<std::uint32_t> inc;  // per group: its blocks (cell << shift | block)
+    Index max_gsize = 0, max_nb = 1;
+    bool aligned = true;  // every block starts at its group's first unknown
+  };
+
+  template <class CellDofsFn>
+  void build(Index nc, CellDofsFn& cell_dofs) {
+    Scratch s;
+    build_local_unknowns(nc, cell_dofs);
+    build_groups(s);
+    build_blocks(s);
+    build_pattern(s);
+    build_schedule(s);
+  }
+
   // Per cell: its field DOFs and its reduced unknown list. Simple cells: N entries (unknown or
   // -1 for fixed). Linked cells: the distinct unknowns, plus for each local DOF entry its
-  // reduced index. Also counts the cells touching each unknown, in outer_ (which becomes the
-  // column starts in build_pattern).
+  // reduced index (in ent_, from ent_start_ of the cell's place in linked_cells_). Also counts
+  // the cells touching each unknown, in outer_ (which becomes the column starts later).
   template <class CellDofsFn>
   void build_local_unknowns(Index nc, CellDofsFn& cell_dofs) {
     using Kind = DofConstraints::Kind;
-    dofs_.resize(nc);
-    general_.assign(nc, 0);
-    red_start_.assign(nc + 1, 0);
-    ent_start_.assign(nc + 1, 0);
-    red_.reserve(std::size_t(nc) * N);
-    outer_.assign(std::size_t(n_unknowns()) + 1, 0);
-    Index* cnt = outer_.data();
+    const DofConstraints& cons = *cons_;
+    CellDofs* dofs = dofs_.resize_for_overwrite(nc);
+    char* general = general_.resize_for_overwrite(nc);
+    Index* red_start = red_start_.resize_for_overwrite(std::size_t(nc) + 1);
+    // N entries per simple cell; a linked cell can need more (grown below if so)
+    Index* red = red_.resize_for_overwrite(std::size_t(nc) * N);
+    Index* cnt = outer_.assign(std::size_t(n_unknowns()) + 1, 0);
+    n_general_ = 0;
+    linked_cells_.clear();
+    ent_start_.assign(1, 0);
+    ent_.clear();
     std::vector<Index> uniq;
+    std::size_t used = 0;
+    red_start[0] = 0;
     for (Index c = 0; c < nc; ++c) {
-      dofs_[c] = cell_dofs(c);
-      const CellDofs& d = dofs_[c];
+      const CellDofs d = cell_dofs(c);
+      dofs[c] = d;
+      std::array<Kind, N> kind;
       bool gen = false;
-      for (Index f : d) gen |= cons_->kind(f) == Kind::linked;
-      general_[c] = gen;
+      for (int i = 0; i < N; ++i) {
+        kind[i] = cons.kind(d[i]);
+        gen |= kind[i] == Kind::linked;
+      }
+      general[c] = gen;
       if (!gen) {
-        for (Index f : d) {
-          const Index u = cons_->kind(f) == Kind::free ? cons_->indices(f)[0] : -1;
-          red_.push_back(u);
-          if (u >= 0) ++cnt[u];
-        }
+        Index* r = red + used;
+        for (int i = 0; i < N; ++i) r[i] = kind[i] == Kind::free ? cons.indices(d[i])[0] : -1;
+        for (int i = 0; i < N; ++i)
+          if (r[i] >= 0) ++cnt[r[i]];
+        used += N;
       } else {
         ++n_general_;
+        linked_cells_.push_back(c);
         uniq.clear();
         for (Index f : d)
-          for (Index u : cons_->indices(f)) uniq.push_back(u);
+          for (Index u : cons.indices(f)) uniq.push_back(u);
         std::sort(uniq.begin(), uniq.end());
         uniq.erase(std::unique(uniq.begin(), uniq.end()), uniq.end());
-        red_.insert(red_.end(), uniq.begin(), uniq.end());
+        const std::size_t need = used + uniq.size() + std::size_t(nc - c - 1) * N;
+        if (need > red_.size()) red = red_.resize_keep(need + need / 8);
+        std::copy(uniq.begin(), uniq.end(), red + used);
+        used += uniq.size();
         for (Index u : uniq) ++cnt[u];
         for (Index f : d)
-          for (Index u : cons_->indices(f))
+          for (Index u : cons.indices(f))
             ent_.push_back(Index(std::lower_bound(uniq.begin(), uniq.end(), u) - uniq.begin()));
+        ent_start_.push_back(Index(ent_.size()));
       }
-      red_start_[c + 1] = static_cast<Index>(red_.size());
-      ent_start_[c + 1] = static_cast<Index>(ent_.size());
+      red_start[c + 1] = Index(used);
     }
+    red_.resize_keep(used);
   }
 
-  // Pattern build by node *groups*. A group is a run of consecutive unknowns touched by
-  // exactly the same cells (the free components of one node; a body's unknowns): its columns
-  // have the same rows, and the rows of any column are whole groups (a cell that touches one
-  // unknown of a group touches all of them). The pattern is stored by groups: each group's
-  // row groups, ascending (`take_pattern` expands them: a group's unknowns are consecutive
-  // and groups are numbered in unknown order, so the rows come out sorted). Groups touched by
-  // the same cells (a *class*: the velocity and the pressure at a vertex) have the same rows,
-  // found and stored once.
-  //
-  // One visit per class, led by the group v met first: the distinct groups of the blocks of
-  // v's cells (a stamp array, branch-free), sorted (a few tens: insertion sort), are v's row
-  // groups; rank[] then gives the offset of each row group (or row) in v's columns, and each
-  // cell touching a group of the class gets the positions of its (row block, column block in
-  // the group) pairs: the rank of each of its blocks. Positions are relative to the column
-  // start (kept per block), so the classes can be visited in any order: a class is visited
-  // when a cell first meets it, cell by cell, so that the cells, blocks and positions being
-  // written stay in a window of the cell order (visiting in unknown order sweeps over all
-  // cells once per kind of node). Positions take 8 bits per entry when the cell's columns
-  // are at most 256 long, 16 bits up to 65536 (all but cells on a large body), else 32.
-  //
-  // The (group, cell) incidences live in `scratch`, left allocated (touched) for
-  // build_schedule.
-  void build_pattern(std::vector<std::uint32_t>& scratch) {
+  // Node groups. A group is a run of consecutive unknowns touched by exactly the same cells
+  // (the free components of one node; a body's unknowns): its columns have the same rows, and
+  // the rows of any column are whole groups (a cell that touches one unknown of a group
+  // touches all of them). u continues the group of u - 1 when the cells touching u are those
+  // touching u - 1: as many, and each cell holding u holds u - 1 (a cell's unknowns are
+  // distinct). s.gid[u]: u's group (numbered in unknown order); gfirst_[g]: its first unknown.
+  void build_groups(Scratch& s) {
     const Index n = n_unknowns(), nc = n_cells();
-    Index* outer = outer_.data();  // the cell counts until the column starts are known
+    const Index* cnt = outer_.data();
     for (Index u = 0; u < n; ++u)
-      if (outer[u] == 0) throw SolverError("unknown " + std::to_string(u) + " is coupled to nothing");
-    // u continues the group of u - 1 when the cells touching u are those touching u - 1: as
-    // many, and each cell holding u holds u - 1 (a cell's unknowns are distinct)
-    std::vector<char> same_prev(n, 0);
-    for (Index u = 1; u < n; ++u) same_prev[u] = outer[u] == outer[u - 1];
+      if (cnt[u] == 0) throw SolverError("unknown " + std::to_string(u) + " is coupled to nothing");
+    // gid (+ 4: the branch-free rank writes of build_pattern) first holds "same as u - 1"
+    Index* gid = s.gid.resize_for_overwrite(std::size_t(n) + 4);
+    if (n > 0) gid[0] = 0;
+    for (Index u = 1; u < n; ++u) gid[u] = cnt[u] == cnt[u - 1];
     for (Index c = 0; c < nc; ++c) {
       const Index* red = &red_[red_start_[c]];
       const Index m = red_start_[c + 1] - red_start_[c];
       for (Index k = 0; k < m; ++k) {
         const Index u = red[k];
-        if (u <= 0 || !same_prev[u] || (k > 0 && red[k - 1] == u - 1)) continue;
-        if (std::find(red, red + m, u - 1) == red + m) same_prev[u] = 0;
+        if (u <= 0 || !gid[u] || (k > 0 && red[k - 1] == u - 1)) continue;
+        if (std::find(red, red + m, u - 1) == red + m) gid[u] = 0;
       }
     }
-    // gid[u]: u's group (numbered in unknown order); gfirst_[g]: its first unknown. gid's
-    // storage is reused below (+ 4: the branch-free rank writes).
-    std::vector<Index> gid(std::size_t(n) + 4);
+    Index* gfirst = gfirst_.resize_for_overwrite(std::size_t(n) + 1);  // a bound: ng + 1 used
     Index ng = 0;
     for (Index u = 0; u < n; ++u) {
-      ng += !same_prev[u];
+      if (!gid[u]) gfirst[ng++] = u;
       gid[u] = ng - 1;
     }
-    gfirst_.assign(std::size_t(ng) + 1, 0);
-    for (Index u = 0; u < n; ++u) gfirst_[gid[u] + 1] = u + 1;
+    gfirst[ng] = n;
+    gfirst_.resize_keep(std::size_t(ng) + 1);
+    s.max_gsize = 0;
+    for (Index g = 0; g < ng; ++g) s.max_gsize = std::max(s.max_gsize, gfirst[g + 1] - gfirst[g]);
+  }
+
+  // Blocks of each cell (runs of local unknowns that are consecutive and of one group): their
+  // start and size in blk_ (the columns are filled in at the end of build_pattern), their
+  // group in s.bg. Per group: its blocks counted (in s.gbstart[g + 1]), its size, and a bound
+  // on its column length (the unknowns of its cells, with repetitions, capped just above the
+  // 16-bit range).
+  void build_blocks(Scratch& s) {
+    const Index nc = n_cells(), ng = Index(gfirst_.size()) - 1;
+    const Index* gid = s.gid.data();
     const Index* gfirst = gfirst_.data();
-    Index max_gsize = 0;
-    for (Index g = 0; g < ng; ++g) max_gsize = std::max(max_gsize, gfirst[g + 1] - gfirst[g]);
-    // blocks of each cell; until the columns are known, `col` holds the block's group
-    blk_start_.assign(nc + 1, 0);
-    blk_.clear();
-    blk_.reserve(red_.size());
-    std::vector<Index> gbstart(std::size_t(ng) + 1, 0);  // per group: its blocks, counted, then CSR starts
-    Index max_nb = 1;
-    bool aligned = true;  // every block starts at its group's first unknown
+    Index* blk_start = blk_start_.resize_for_overwrite(std::size_t(nc) + 1);
+    Block* blk = blk_.resize_for_overwrite(red_.size());  // bounds: one block per unknown
+    Index* bg = s.bg.resize_for_overwrite(red_.size());
+    Index* count = s.gbstart.assign(std::size_t(ng) + 1, 0);
+    GroupState* gs = s.gs.resize_for_overwrite(ng);
+    for (Index g = 0; g < ng; ++g) gs[g] = GroupState{-1, 0, gfirst[g + 1] - gfirst[g], 0};
+    Index nb_all = 0, max_nb = 1;
+    bool aligned = true;
+    blk_start[0] = 0;
     for (Index c = 0; c < nc; ++c) {
       const Index* red = &red_[red_start_[c]];
       const Index m = red_start_[c + 1] - red_start_[c];
+      const Index b0 = nb_all;
+      Index mc = 0;
       for (Index k = 0; k < m;) {
         if (red[k] < 0) {
           ++k;
@@ -458,99 +696,117 @@ class Assembler {
         aligned &= red[k] == gfirst[g];
         Index e = k + 1;
         while (e < m && red[e] == red[e - 1] + 1 && gid[red[e]] == g) ++e;
-        blk_.push_back(Block{std::int16_t(k), std::int16_t(e - k), 0, g});
-        ++gbstart[g + 1];
+        blk[nb_all] = Block{std::int16_t(k), std::int16_t(e - k), 0, 0};
+        bg[nb_all++] = g;
+        ++count[g + 1];
+        mc += e - k;
         k = e;
       }
-      blk_start_[c + 1] = Index(blk_.size());
-      max_nb = std::max(max_nb, blk_start_[c + 1] - blk_start_[c]);
+      for (Index b = b0; b < nb_all; ++b) gs[bg[b]].len = std::min(gs[bg[b]].len + mc, len16 + 1);
+      blk_start[c + 1] = nb_all;
+      max_nb = std::max(max_nb, nb_all - b0);
     }
+    blk_.resize_keep(std::size_t(nb_all));
+    s.bg.resize_keep(std::size_t(nb_all));
+    s.max_nb = max_nb;
+    s.aligned = aligned;
+  }
+
+  static constexpr Index len8 = 256, len16 = 65536;  // longest columns with 8-, 16-bit positions
+
+  // One visit per class: groups touched by the same cells (a *class*: the velocity and the
+  // pressure at a vertex) have the same rows, found and stored once. The pattern is stored by
+  // groups: each class's row groups, ascending (`take_pattern` expands them: a group's
+  // unknowns are consecutive and groups are numbered in unknown order, so the rows come out
+  // sorted).
+  //
+  // The visit of a class, led by the group v met first: the distinct groups of the blocks of
+  // v's cells (a stamp, branch-free), sorted (a few tens: insertion sort), are v's row
+  // groups; their ranks then give the offset of each row group (or row) in v's columns, and
+  // each cell touching v gets the positions of its (row block, column block v) pairs: the
+  // rank of each of its blocks; the cells' positions in the columns of v's class mates are
+  // copies of those. Positions are relative to the column start (kept per block), so the
+  // classes can be visited in any order: a class is visited when a cell first meets it, cell
+  // by cell, so that the cells, blocks and positions being written stay in a window of the
+  // cell order (visiting in unknown order sweeps over all cells once per kind of node).
+  // Positions take 8 bits per entry when the cell's columns are at most 256 long, 16 bits up
+  // to 65536 (all but cells on a large body), else 32.
+  void build_pattern(Scratch& s) {
+    const Index n = n_unknowns(), nc = n_cells(), ng = Index(gfirst_.size()) - 1;
+    const Index* gfirst = gfirst_.data();
+    const Index max_nb = s.max_nb, max_gsize = s.max_gsize;
+    const bool aligned = s.aligned;
+    Index* gbstart = s.gbstart.data();
+    GroupState* gs = s.gs.data();
+    const Index* bg = s.bg.data();
     Index max_inc = 0;
     for (Index g = 0; g < ng; ++g) max_inc = std::max(max_inc, gbstart[g + 1]);
-    std::partial_sum(gbstart.begin(), gbstart.end(), gbstart.begin());
-    // per group: its blocks as (cell << shift | local block index), in cell order; glen[g]
-    // first bounds g's column length (the unknowns of its cells, with repetitions)
+    std::partial_sum(gbstart, gbstart + ng + 1, gbstart);
+    // per group: its blocks as (cell << shift | local block index), in cell order
     const int shift = std::bit_width(std::uint32_t(max_nb - 1));
     if (std::uint64_t(nc) << shift > std::numeric_limits<std::uint32_t>::max())
       throw SolverError("Assembler: too many cells for the pattern build (cells x blocks per cell >= 2^32)");
     const std::uint32_t jmask = (std::uint32_t(1) << shift) - 1;
-    scratch.resize(std::max<std::size_t>(blk_.size(), n));  // build_schedule needs n
-    std::uint32_t* inc = scratch.data();
-    std::vector<Index> glen(ng, 0);
-    constexpr Index len8 = 256, len16 = 65536;  // longest columns with 8-, 16-bit positions
-    {
-      Index* at = gid.data();  // insertion cursor per group
-      std::copy(gbstart.begin(), gbstart.end() - 1, at);
-      for (Index c = 0; c < nc; ++c) {
-        const Index b0 = blk_start_[c], b1 = blk_start_[c + 1];
-        Index mc = 0;
-        for (Index b = b0; b < b1; ++b) mc += blk_[b].size;
-        for (Index b = b0; b < b1; ++b) {
-          const Index g = blk_[b].col;
-          inc[at[g]++] = std::uint32_t(c) << shift | std::uint32_t(b - b0);
-          glen[g] = std::min(glen[g] + mc, len16 + 1);
-        }
-      }
-    }
+    std::uint32_t* inc = s.inc.resize_for_overwrite(blk_.size());
     // positions: per cell, nb x nb row offsets (row block I in the columns of block J at
     // J * nb + I), 8-bit if all its columns are at most len8 long, 16-bit if at most len16,
     // 32-bit otherwise. Every (row block, column block) pair of every cell is written below
     // exactly once.
-    width_.assign(nc, 0);
-    pos_start_.assign(nc, 0);
+    char* width = width_.resize_for_overwrite(nc);
+    std::int64_t* pos_start = pos_start_.resize_for_overwrite(nc);
+    const Index* bstart = blk_start_.data();
     std::int64_t npos[3] = {0, 0, 0};
-    for (Index c = 0; c < nc; ++c) {
-      const Index b0 = blk_start_[c], nb = blk_start_[c + 1] - b0;
-      Index longest = 0;
-      for (Index b = b0; b < b0 + nb; ++b) longest = std::max(longest, glen[blk_[b].col]);
-      const int w = longest <= len8 ? 0 : longest <= len16 ? 1 : 2;
-      width_[c] = char(w);
-      pos_start_[c] = npos[w];
-      npos[w] += std::int64_t(nb) * nb;
+    {
+      Index* at = s.gid.data();  // insertion cursor per group (gid is no longer needed)
+      std::copy(gbstart, gbstart + ng, at);
+      for (Index c = 0; c < nc; ++c) {
+        const Index b0 = bstart[c], nb = bstart[c + 1] - b0;
+        Index longest = 0;
+        for (Index J = 0; J < nb; ++J) {
+          const Index g = bg[b0 + J];
+          longest = std::max(longest, gs[g].len);
+          inc[at[g]++] = std::uint32_t(c) << shift | std::uint32_t(J);
+        }
+        const int w = longest <= len8 ? 0 : longest <= len16 ? 1 : 2;
+        width[c] = char(w);
+        pos_start[c] = npos[w];
+        npos[w] += std::int64_t(nb) * nb;
+      }
     }
-    pos8_.reset(new std::uint8_t[std::size_t(npos[0])]);
-    pos16_.reset(new std::uint16_t[std::size_t(npos[1])]);
-    pos32_.reset(new Index[std::size_t(npos[2])]);
+    std::uint8_t* pos8 = pos8_.resize_for_overwrite(std::size_t(npos[0]));
+    std::uint16_t* pos16 = pos16_.resize_for_overwrite(std::size_t(npos[1]));
+    Index* pos32 = pos32_.resize_for_overwrite(std::size_t(npos[2]));
     n_pos_ = std::size_t(npos[0] + npos[1] + npos[2]);
     n_pos_bytes_ = std::size_t(npos[0] + 2 * npos[1] + 4 * npos[2]);
-    std::fill(glen.begin(), glen.end(), -1);  // now: -1 until the group is visited
+    for (Index g = 0; g < ng; ++g) gs[g].len = -1;  // now: -1 until the group is visited
     // the row groups of the classes, in visiting order: at most one per (cell, row block,
     // column block), so allocated for that bound (the pages past the final size are never
     // touched)
-    gadj_at_.assign(std::size_t(ng) + 1, 0);
-    gadj_.reset(new Index[n_pos_ + 1]);
-    Index* gadj = gadj_.get();
-    // rank[x]: the offset of row group x in the columns being visited (when all blocks are
-    // aligned on their groups), else rank[u] the offset of row u; gid's storage
-    Index* rank = gid.data();
+    Index* gadj_at = gadj_at_.resize_for_overwrite(std::size_t(ng) + 1);
+    Index* gadj = gadj_.resize_for_overwrite(n_pos_ + 1);
+    // when not all blocks are aligned on their groups: rank[u], the offset of row u in the
+    // columns being visited (gid's storage)
+    Index* rank = s.gid.data();
     // nbrs[0]: a sentinel for sort_small, the candidates from nbrs[1]
-    std::vector<Index> stamp(ng, -1), buf(std::size_t(max_inc) * std::size_t(max_nb) + 2);
+    std::vector<Index> buf(std::size_t(max_inc) * std::size_t(max_nb) + 2);
     buf[0] = std::numeric_limits<Index>::min();
     Index* nbrs = buf.data() + 1;
+    const Index* red_all = red_.data();
+    const Index* rstart = red_start_.data();
     const Block* blk_all = blk_.data();
-    const Index* bstart = blk_start_.data();
     Index a = 0;
-    // the positions of the blocks in group v (v's rows in rank)
-    auto positions = [&](Index v) {
-      auto put = [&](auto* pj, Index nb, const Block* blk, const Index* red) {
-        using P = std::remove_reference_t<decltype(*pj)>;
-        const Index* rk = rank;  // a local: the 8-bit stores may alias anything else
-        if (aligned)
-          for (Index I = 0; I < nb; ++I) pj[I] = P(rk[blk[I].col]);
-        else
-          for (Index I = 0; I < nb; ++I) pj[I] = P(rk[red[blk[I].start]]);
-      };
-      const Index k1 = gbstart[v + 1];
-      for (Index k = gbstart[v]; k < k1; ++k) {
-        const Index c = Index(inc[k] >> shift), J = Index(inc[k] & jmask);
-        const Index b0 = bstart[c], nb = bstart[c + 1] - b0;
-        const std::int64_t at = pos_start_[c] + std::int64_t(J) * nb;
-        const Index* red = &red_[red_start_[c]];
-        switch (width_[c]) {
-          case 0: put(&pos8_[at], nb, blk_all + b0, red); break;
-          case 1: put(&pos16_[at], nb, blk_all + b0, red); break;
-          default: put(&pos32_[at], nb, blk_all + b0, red);
-        }
+    // cell c's positions in the columns of its block J: the ranks of its blocks
+    auto put = [&](auto* pj, Index c, Index nb) {
+      using P = std::remove_reference_t<decltype(*pj)>;
+      const Index* b = bg + bstart[c];
+      if (aligned) {
+        const GroupState* g = gs;  // locals: the 8-bit stores may alias anything else
+        for (Index I = 0; I < nb; ++I) pj[I] = P(g[b[I]].rank);
+      } else {
+        const Index* rk = rank;
+        const Index* red = red_all + rstart[c];
+        const Block* blk = blk_all + bstart[c];
+        for (Index I = 0; I < nb; ++I) pj[I] = P(rk[red[blk[I].start]]);
       }
     };
     auto visit = [&](Index v) {
@@ -558,68 +814,90 @@ class Assembler {
       const Index k0 = gbstart[v], k1 = gbstart[v + 1];
       for (Index k = k0; k < k1; ++k) {
         const Index c = Index(inc[k] >> shift);
-        const Block* b = blk_all + bstart[c];
-        const Block* e = blk_all + bstart[c + 1];
-        for (; b < e; ++b) {
-          const Index x = b->col;
+        for (Index b = bstart[c]; b < bstart[c + 1]; ++b) {
+          const Index x = bg[b];
           nbrs[m] = x;
-          m += stamp[x] != v;
-          stamp[x] = v;
+          m += gs[x].stamp != v;
+          gs[x].stamp = v;
         }
       }
       sort_small(nbrs, m);
       Index len = 0;
       if (aligned) {
         for (Index k = 0; k < m; ++k) {
-          rank[nbrs[k]] = len;
-          len += gfirst[nbrs[k] + 1] - gfirst[nbrs[k]];
+          GroupState& x = gs[nbrs[k]];
+          x.rank = len;
+          len += x.size;
         }
       } else if (max_gsize <= 4) {  // 4 entries per group (the excess is overwritten by the
                                     // next groups or belongs to no row of v)
         for (Index k = 0; k < m; ++k) {
           const Index u0 = gfirst[nbrs[k]];
           for (Index t = 0; t < 4; ++t) rank[u0 + t] = len + t;
-          len += gfirst[nbrs[k] + 1] - u0;
+          len += gs[nbrs[k]].size;
         }
       } else {
         for (Index k = 0; k < m; ++k)
           for (Index u = gfirst[nbrs[k]]; u < gfirst[nbrs[k] + 1]; ++u) rank[u] = len++;
       }
       std::copy(nbrs, nbrs + m, gadj + a);
-      gadj_at_[v] = a;
+      gadj_at[v] = a;
       a += m;
-      glen[v] = len;
-      positions(v);
+      gs[v].len = len;
+      for (Index k = k0; k < k1; ++k) {
+        const Index c = Index(inc[k] >> shift), J = Index(inc[k] & jmask);
+        const Index nb = bstart[c + 1] - bstart[c];
+        const std::int64_t at = pos_start[c] + std::int64_t(J) * nb;
+        switch (width[c]) {
+          case 0: put(pos8 + at, c, nb); break;
+          case 1: put(pos16 + at, c, nb); break;
+          default: put(pos32 + at, c, nb);
+        }
+      }
       // the groups touched by the same cells as v (the pressure at a velocity node: v's
-      // class) have v's rows: they are among the blocks of v's first cell after v's (the
-      // blocks before it have been visited), not visited yet
+      // class) have v's rows, and so each cell's positions in their columns are those in
+      // v's: they are among the blocks of v's first cell after v's (the blocks before it
+      // have been visited), not visited yet
       const Index c0 = Index(inc[k0] >> shift), nv = k1 - k0;
       for (Index b = bstart[c0] + Index(inc[k0] & jmask) + 1; b < bstart[c0 + 1]; ++b) {
-        const Index g = blk_all[b].col;
-        if (glen[g] >= 0 || gbstart[g + 1] - gbstart[g] != nv) continue;
+        const Index g = bg[b];
+        if (gs[g].len >= 0 || gbstart[g + 1] - gbstart[g] != nv) continue;
+        const std::uint32_t* ig = inc + gbstart[g];
         Index k = 0;
-        while (k < nv && inc[gbstart[g] + k] >> shift == inc[k0 + k] >> shift) ++k;
+        while (k < nv && ig[k] >> shift == inc[k0 + k] >> shift) ++k;
         if (k < nv) continue;
-        gadj_at_[g] = gadj_at_[v];
-        glen[g] = len;
-        positions(g);
+        gadj_at[g] = gadj_at[v];
+        gs[g].len = len;
+        for (k = 0; k < nv; ++k) {
+          const Index c = Index(ig[k] >> shift), nb = bstart[c + 1] - bstart[c];
+          const std::int64_t from = pos_start[c] + std::int64_t(inc[k0 + k] & jmask) * nb;
+          const std::int64_t to = pos_start[c] + std::int64_t(ig[k] & jmask) * nb;
+          switch (width[c]) {
+            case 0: std::copy_n(pos8 + from, nb, pos8 + to); break;
+            case 1: std::copy_n(pos16 + from, nb, pos16 + to); break;
+            default: std::copy_n(pos32 + from, nb, pos32 + to);
+          }
+        }
       }
     };
-    for (const Block& b : blk_)
-      if (glen[b.col] < 0) visit(b.col);
-    gadj_at_[ng] = a;
-    // column starts (in unknown order), then each block's column start
+    for (std::size_t b = 0; b < blk_.size(); ++b)
+      if (gs[bg[b]].len < 0) visit(bg[b]);
+    gadj_at[ng] = a;
+    gadj_.resize_keep(std::size_t(a));
+    // column starts (in unknown order), then each block's column start and length
+    Index* outer = outer_.data();
     std::int64_t nnz = 0;
     for (Index g = 0; g < ng; ++g)
-      for (Index u = gfirst[g]; u < gfirst[g + 1]; ++u, nnz += glen[g]) outer[u] = Index(nnz);
+      for (Index u = gfirst[g]; u < gfirst[g + 1]; ++u, nnz += gs[g].len) outer[u] = Index(nnz);
     if (nnz > std::numeric_limits<Index>::max())
       throw SolverError("Assembler: the matrix pattern exceeds 2^31 nonzeros (Index is 32 bit)");
     outer[n] = Index(nnz);
+    Block* blk = blk_.data();
     for (Index c = 0; c < nc; ++c) {
-      const Index* red = &red_[red_start_[c]];
-      for (Index b = blk_start_[c]; b < blk_start_[c + 1]; ++b) {
-        blk_[b].stride = glen[blk_[b].col];
-        blk_[b].col = outer[red[blk_[b].start]];
+      const Index* red = red_all + rstart[c];
+      for (Index b = bstart[c]; b < bstart[c + 1]; ++b) {
+        blk[b].stride = gs[bg[b]].len;
+        blk[b].col = outer[red[blk[b].start]];
       }
     }
   }
@@ -642,43 +920,38 @@ class Assembler {
   // Thread schedule: chunks of consecutive simple cells, greedily coloured (a chunk takes the
   // lowest colour none of its unknowns has been given yet; 32 colours per round, chunks that
   // find none start a new round of 32: the colouring does not depend on the round size).
-  // `used`: a buffer already touched by build_pattern.
-  void build_schedule(std::vector<std::uint32_t>& used) {
-    const Index nc = n_cells(), n = n_unknowns();
-    chunk_cells_.clear();
-    chunk_start_.assign(1, 0);
-    linked_cells_.clear();
-    for (Index c = 0; c < nc; ++c) {
-      if (general_[c]) {
-        linked_cells_.push_back(c);
-        continue;
-      }
-      chunk_cells_.push_back(c);
-      if (Index(chunk_cells_.size()) - chunk_start_.back() == chunk_size) chunk_start_.push_back(Index(chunk_cells_.size()));
-    }
-    if (chunk_start_.back() != Index(chunk_cells_.size())) chunk_start_.push_back(Index(chunk_cells_.size()));
-    const Index nch = Index(chunk_start_.size()) - 1;
+  void build_schedule(Scratch& s) {
+    const Index nc = n_cells();
+    Index* cells = chunk_cells_.resize_for_overwrite(std::size_t(nc - n_general_));
+    const Index ns = nc - n_general_;
+    for (Index c = 0, i = 0; c < nc; ++c)
+      if (!general_[c]) cells[i++] = c;
+    const Index nch = (ns + chunk_size - 1) / chunk_size;
+    chunk_start_.resize(std::size_t(nch) + 1);
+    for (Index ch = 0; ch <= nch; ++ch) chunk_start_[ch] = std::min(ch * chunk_size, ns);
+    // by groups: two cells share an unknown exactly when they share a group (a cell touching
+    // one unknown of a group touches all of it), so colouring the groups of the cells' blocks
+    // colours their unknowns
     std::vector<Index> colour(nch, -1);
+    const Index ng = Index(gfirst_.size()) - 1;
+    const Index* bg = s.bg.data();
+    const Index* bstart = blk_start_.data();
+    // `used`: the incidences' storage (touched already; one per block, so at least ng)
+    std::uint32_t* used = s.inc.resize_for_overwrite(std::size_t(ng));
     Index base = 0, left = nch;
     while (left > 0) {  // one round of up to 32 colours over the chunks still uncoloured
-      used.assign(n, 0);
+      std::fill_n(used, ng, 0);
       for (Index ch = 0; ch < nch; ++ch) {
         if (colour[ch] >= 0) continue;
         std::uint32_t busy = 0;
-        for (Index i = chunk_start_[ch]; i < chunk_start_[ch + 1]; ++i) {
-          const Index c = chunk_cells_[i];
-          for (Index k = red_start_[c]; k < red_start_[c + 1]; ++k)
-            if (red_[k] >= 0) busy |= used[red_[k]];
-        }
+        for (Index i = chunk_start_[ch]; i < chunk_start_[ch + 1]; ++i)
+          for (Index b = bstart[cells[i]]; b < bstart[cells[i] + 1]; ++b) busy |= used[bg[b]];
         if (busy == ~std::uint32_t(0)) continue;
         const int bit = std::countr_one(busy);
         colour[ch] = base + bit;
         --left;
-        for (Index i = chunk_start_[ch]; i < chunk_start_[ch + 1]; ++i) {
-          const Index c = chunk_cells_[i];
-          for (Index k = red_start_[c]; k < red_start_[c + 1]; ++k)
-            if (red_[k] >= 0) used[red_[k]] |= std::uint32_t(1) << bit;
-        }
+        for (Index i = chunk_start_[ch]; i < chunk_start_[ch + 1]; ++i)
+          for (Index b = bstart[cells[i]]; b < bstart[cells[i] + 1]; ++b) used[bg[b]] |= std::uint32_t(1) << bit;
       }
       base += 32;
     }
@@ -698,28 +971,30 @@ class Assembler {
   }
 
   const DofConstraints* cons_;
-  std::vector<CellDofs> dofs_;
-  std::vector<char> general_;
+  detail::UninitArray<CellDofs> dofs_;
+  detail::UninitArray<char> general_;
   Index n_general_ = 0;
-  std::vector<Index> red_start_, red_, ent_start_, ent_;
-  std::vector<Index> blk_start_;
-  std::vector<Block> blk_;
+  detail::UninitArray<Index> red_start_, red_;
+  // linked cells (ascending) and, per linked cell, its entries' reduced indices at ent_start_[i]
+  std::vector<Index> linked_cells_, ent_start_, ent_;
+  detail::UninitArray<Index> blk_start_;
+  detail::UninitArray<Block> blk_;
   // positions (row offsets in the column) of cell c at pos8_/pos16_/pos32_[pos_start_[c]] by
   // width_[c] = 0/1/2
-  std::unique_ptr<std::uint8_t[]> pos8_;
-  std::unique_ptr<std::uint16_t[]> pos16_;
-  std::unique_ptr<Index[]> pos32_;
-  std::vector<char> width_;
+  detail::UninitArray<std::uint8_t> pos8_;
+  detail::UninitArray<std::uint16_t> pos16_;
+  detail::UninitArray<Index> pos32_;
+  detail::UninitArray<char> width_;
   std::size_t n_pos_ = 0, n_pos_bytes_ = 0;
-  std::vector<std::int64_t> pos_start_;  // can exceed 2^31 for big 3D P2 meshes
-  std::vector<Index> chunk_cells_, chunk_start_, chunk_order_, colour_start_, linked_cells_;
+  detail::UninitArray<std::int64_t> pos_start_;  // can exceed 2^31 for big 3D P2 meshes
+  detail::UninitArray<Index> chunk_cells_;
+  std::vector<Index> chunk_start_, chunk_order_, colour_start_;
   int threads_ = 1;
-  std::vector<Index> outer_;           // CSC pattern: column starts
+  detail::UninitArray<Index> outer_;  // CSC pattern: column starts
   // the rows by groups: group g = unknowns gfirst_[g] .. gfirst_[g + 1] - 1; its columns' rows
   // are the groups at gadj_[gadj_at_[g]], ascending, as many as make up the column length
-  std::vector<Index> gfirst_, gadj_at_;
-  std::unique_ptr<Index[]> gadj_;
-  mutable SparseMatrix matrix_;        // matrix(): built on demand
+  detail::UninitArray<Index> gfirst_, gadj_at_, gadj_;
+  mutable SparseMatrix matrix_;  // matrix(): built on demand
   mutable bool matrix_built_ = false;
 };
 

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <set>
@@ -183,6 +184,33 @@ TEST_CASE("checkpoint + restart continues bit for bit, across remeshes", "[check
     CHECK_THROWS_WITH(read_checkpoint_mesh<2>(file), Catch::Contains("truncated at byte"));
   }
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("FlowOptions::threads: two assembly threads give the one-thread run bit for bit, across remeshes",
+          "[threads][quick]") {
+  // the coarse DKT scene: two free disks, collisions, a remesh after every step
+  const std::vector<Circle> disks = {{Vec<2>(0.999, 5), 0.125, 5}, {Vec<2>(1, 4.5), 0.125, 6}};
+  auto run = [&](int threads) {
+    auto flow = std::make_unique<Dkt>(channel_with_disks(2, 6, disks, 0.04, 0.3),
+                                      FlowOptions{.rho = 1, .mu = 0.01, .threads = threads});
+    configure(*flow, disks);
+    for (int n = 0; n < 6; ++n) {
+      flow->step(2e-3);
+      flow->remesh();
+    }
+    return flow;
+  };
+  const auto one = run(1), two = run(2);
+  REQUIRE(two->stats().remeshes >= 5);
+  REQUIRE(two->mesh().n_nodes() == one->mesh().n_nodes());
+  CHECK(two->mesh().coordinates() == one->mesh().coordinates());
+  CHECK(two->field() == one->field());  // bit for bit
+  for (std::size_t b = 0; b < 2; ++b) {
+    CHECK(two->body_centre(b) == one->body_centre(b));
+    CHECK(two->body_velocity(b) == one->body_velocity(b));
+  }
+  CHECK_THROWS_WITH((Dkt(channel_with_disks(2, 6, disks, 0.04, 0.3), FlowOptions{.rho = 1, .mu = 0.01, .threads = 0})),
+                    Catch::Contains("threads"));
 }
 
 TEST_CASE("bad scenes are refused before the first step, naming the parameter", "[scene][quick]") {

@@ -98,6 +98,10 @@ struct FlowOptions {
   /// t^n + dt (equal spacing dt); a scheme that needs more levels continues with its MR/AB
   /// start-up steps.
   int damped_start = 0;
+  /// Threads of the flow system's assembly (Assembler::set_threads; default 1). Results are
+  /// bit-identical for every count. With more than one, the user's force callback
+  /// (set_force) is called concurrently and must be safe to call so (a pure function is).
+  int threads = 1;
 };
 
 /// Remeshing in the time loop (2D). Trigger: worst cell quality (Mesh::quality) below
@@ -196,6 +200,7 @@ class AleFlow {
     ALEFSI_CHECK_ARG(opt.rho >= 0 && std::isfinite(opt.rho), "rho", "fluid density must be >= 0 and finite, got ", opt.rho);
     ALEFSI_CHECK_ARG(opt.mu > 0 && std::isfinite(opt.mu), "mu", "viscosity must be positive and finite, got ", opt.mu);
     ALEFSI_CHECK_ARG(opt.max_newton >= 1, "max_newton", "must be >= 1");
+    ALEFSI_CHECK_ARG(opt.threads >= 1, "threads", "must be at least 1, got ", opt.threads);
     ALEFSI_CHECK_ARG(opt.damped_start == 0 || (opt.damped_start >= 2 && opt.damped_start <= 64 && opt.damped_start % 2 == 0),
                      "damped_start", "must be 0 (off) or an even number of substeps in 2..64, got ", opt.damped_start);
     rebuild_discretisation();
@@ -582,6 +587,7 @@ class AleFlow {
     cons_->finalize();
     asmb_ = std::make_unique<Assembler<Space::n_local>>(
         mesh_.n_cells(), [&](Index c) { return space_->cell_field_dofs(c); }, *cons_);
+    asmb_->set_threads(opt_.threads);
     for (const auto& b : bodies_)  // disks and spheres: their surface is on the given radius
       if (b.data.radius > 0)
         for (Index v : b.nodes)

@@ -1,10 +1,33 @@
 // Largest stable time step of each ALE scheme on a reference problem, by bisection.
 //
+//   cmake ... -DALEFSI_BUILD_BENCH=ON && cmake --build <dir> --target ale_stability   (or by hand:)
 //   g++ -std=c++20 -O3 -march=native -DNDEBUG -Iinclude -I/usr/include/eigen3 bench/ale_stability.cpp -o /tmp/ale_stability
+//     (by hand without SuiteSparse: no --solver umfpack; add -DALEFSI_HAVE_SUITESPARSE
+//      -I/usr/include/suitesparse ... -lumfpack -lcholmod for it; the CMake target does that)
 //   /tmp/ale_stability [--schemes MR_AB,BDF2_BDF2E,BDF2_AB,BDF3_BDF3E,BSS] [--h 0.05] [--mu 1,0.01]
 //                      [--T 2] [--min-steps 200] [--dt-lo 0.005] [--dt-hi 0.5] [--tol 0.02]
 //                      [--lin newton|semi] [--mesh-motion shear|rigid] [--max-drift D] [--csv FILE]
 //                      [--trace DT] [--inner fixed|free] [--rho-s R] [--pair gls|th]
+//                      [--solver sparselu|umfpack] [--startup-steps 10] [--energy-bound F]
+//                      [--probes DT1,DT2,...] [--remesh Q] [--remesh-size] [--u-bound F]
+//                      [--trace-every N]
+//
+//   --solver   linear solver of the flow system: SparseLu<> (default; saddle-point AMD) or
+//              UmfPackLu (needs ALEFSI_HAVE_SUITESPARSE). Same results to solver round-off.
+//   --trace DT one run per scheme and mu at DT, printing per step: E, max |u|, E^{n+1}/E^n,
+//              drift, min quality, body w, Newton iterations and the step's wall time by phase
+//              (mesh velocity, assembly, factorisation, solves): the first 12 steps, then about 40
+//              lines, or every N-th step with --trace-every N.
+//   --probes   runs these dt per scheme and mu (no bisection) and prints a table of outcomes.
+//   --remesh Q (--inner free only) AleFlow::set_remeshing with trigger quality Q, walls = the
+//              outer circle, no size function (the adaptation keeps the mesh's own edge lengths;
+//              only the quality triggers); the body is then declared a disk (radius R1) so the
+//              adaptation keeps it on its circle. The probe line counts the remeshes.
+//   --remesh-size  with --remesh: target size uniform h, whose size band (an edge off h by
+//              more than 70 %) also triggers: in the sheared annulus that remeshes at most steps.
+// Every probe line gives its wall time and process CPU time (std::clock) (the table and the CSV
+// give both per scheme), the largest |x_g| of a free body (|xg|) and the largest E^{n+1}/E^n at
+// the steps the energy test checked (Er; 0 if it checked none: runs of <= --startup-steps steps).
 //
 // Problem (the annulus of the paper's Figure 7 set-up, WITHOUT the free inner body): fluid in
 // R1 = 0.25 < |x| < R2 = 1, rho = 1, mu from --mu (each value is a separate table row); the
@@ -29,19 +52,29 @@
 //
 // "Stable" at dt: the run reaches max(T, min_steps * dt) (default max(2 s, 200 steps)) and none
 // of these happens at any step:
-//   newton   Newton does not converge (25 iterations, relative residual 1e-10), or SparseLU fails;
+//   newton   Newton does not converge (25 iterations, relative residual 1e-10), or the linear
+//            solver fails;
 //   blow-up  a non-finite value, or max |u_h| > 10 x the maximal wall speed (omega R2 = 1);
-//   energy   after the start-up (step n >= 10 and t >= 10 x the diffusive time h^2 rho / mu,
-//            capped at 1 s) the kinetic energy grows by more than 10 % in one step,
-//            E^{n+1} > 1.1 E^n (a spin-up from rest grows slower than that once the start-up
-//            transient is over);
+//   energy   after the start-up (step n >= --startup-steps, default 10, and t >= 10 x the
+//            diffusive time h^2 rho / mu, capped at 1 s) the kinetic energy grows by more than
+//            10 % in one step, E^{n+1} > 1.1 E^n. Why that is safe for a spin-up from rest: if
+//            E(t) is concave with E(0) = 0 then E(t + dt) / E(t) <= 1 + dt / t, and t >= 10 dt
+//            after 10 steps. The test is therefore never active in a run of 10 steps or fewer
+//            (dt > T / 11 with the free body's short runs): there only blow-up, drift, newton,
+//            mesh and the opt-in E-bound can fail a probe;
 //   drift    a wall node is more than --max-drift (default h; 0 disables) off its circle: the
 //            domain is no longer the annulus (at dt = 0.5 BDF3/BDF3E shrinks the whole mesh
 //            towards the centre while the flow criteria stay quiet, so this one is needed);
 //   E-bound  only with --energy-bound F (off by default; the tables in docs/ale_benchmarks.md
-//            were measured without it): E > F x E_max, E_max = 1/2 rho |Omega| (omega R2)^2, the
+//            were measured without it; active from the first step): E > F x E_max, E_max = 1/2 rho |Omega| (omega R2)^2, the
 //            energy of the whole fluid at the largest wall speed (|u| <= omega R2 for this flow).
 //            Catches slow energy growth the 10 %-per-step test misses (MR/AB, mu = 0.01).
+//   u-bound  only with --u-bound F (off by default): after the start-up (the energy test's window)
+//            max |u_h| > F x omega R2. For this flow |u| <= omega R2 (maximum principle; the
+//            free body turns no faster than the outer wall); F = 1.1 leaves room for discrete
+//            overshoot (the runs judged stable here stay below 1.03 omega R2). Catches the slow growth that the per-step
+//            energy test misses in long runs (MR/AB above dt ~ 0.2: w drifts to 0.9 or 1.4 over
+//            tens of seconds, E never grows 10 % in one step);
 //   mesh     a cell is inverted or degenerate, or the elasticity matrix is not SPD. This is a
 //            failure of the mesh motion, not of the time scheme; it is reported separately
 //            and counted as "not stable" by the bisection (the table says so).
@@ -59,6 +92,14 @@
 // omega t rad against the fixed outer ring; at h = 0.05 the smallest cell quality falls from
 // 0.6 to 0.035 by t = 2 s), so the free runs are short and end at a fixed time: defaults T = 1 s,
 // min-steps 5 (overridable). Extra failure criterion: |w_body| > 10 omega (blow-up).
+// With a free body the outer-wall nodes do not move, so "drift" measures how far the body's
+// centre has left the axis (exactly 0 for this flow). That offset grows smoothly with dt (MR/AB,
+// h = 0.05: 1.3e-5, 7.5e-4, 5.6e-3 at dt = 0.02, 0.1, 0.22 by t = 1.5), so it is an accuracy
+// threshold, and its default (h) is stricter on finer meshes: give --max-drift explicitly to
+// compare meshes. "mesh" failures at large dt are single steps that invert a cell next to the
+// body (h = 0.01: inverted cells at radius 0.252-0.256, one at 0.299), also right after a
+// remesh; --remesh lifts only the slow shear of long runs. Long runs: --remesh 0.35 --T 30 --u-bound 1.1
+// --max-drift 0 (the body centre may move; the adaptation keeps the disk and walls exact).
 // The paper's critical steps (P1/P1-GLS, h = 0.01: 0.06, 0.110, 0.108, 0.113, 0.025 for MR/AB,
 // BDF2/BDF2E, BDF2/AB, BDF3/BDF3E, BSS) are for this set-up; docs/results.md gives ours and
 // the h they were measured at.
@@ -67,14 +108,15 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <fstream>
 #include <functional>
 #include <numbers>
 #include <sstream>
 #include <string>
-#include <type_traits>
 #include <vector>
 
+#include "alefsi/la/suitesparse.hpp"
 #include "alefsi/mesh/generate/mesher2d.hpp"
 #include "alefsi/sim/ale_flow.hpp"
 
@@ -92,14 +134,20 @@ struct Settings {
   Linearisation lin = Linearisation::newton;
   Real max_drift = -1;  // < 0: h; 0: no drift criterion
   Real energy_bound = 0;  // > 0: unstable if E > energy_bound * E_max (opt-in, see the header)
+  Real u_bound = 0;       // > 0: unstable if max |u_h| > u_bound * omega R2 after the start-up (opt-in)
   bool rigid = false;  // --mesh-motion rigid: the inner-wall nodes slide with the rotation too
   Real trace_dt = 0;  // > 0: one verbose run at this dt per scheme and mu, no bisection
+  int trace_every = 0;  // --trace-every N: print every N-th step (default: the first 12, then ~40 lines)
   bool free_body = false;  // --inner free: the inner cylinder is a free rigid body (the paper's set-up)
   Real rho_s = 1.25;       // its density
   bool taylor_hood = false;  // --pair th (default P1/P1-GLS, the paper's pair for this study)
+  bool umfpack = false;      // --solver umfpack (default sparselu: SparseLu<>, saddle-point AMD)
+  Real remesh_quality = 0;   // --remesh Q (> 0, free body only): AleFlow::set_remeshing, trigger quality Q
+  bool remesh_size = false;  // --remesh-size: also a target size h (and its size-band trigger)
+  std::vector<Real> probe_dts;  // --probes DT1,DT2,...: these probes per scheme and mu, no bisection
 };
 
-enum class Outcome { stable, newton, blowup, energy, bound, drift, mesh };
+enum class Outcome { stable, newton, blowup, energy, bound, ubound, drift, mesh };
 const char* outcome_name(Outcome o) {
   switch (o) {
     case Outcome::stable: return "stable";
@@ -107,6 +155,7 @@ const char* outcome_name(Outcome o) {
     case Outcome::blowup: return "blow-up";
     case Outcome::energy: return "energy";
     case Outcome::bound: return "E-bound";
+    case Outcome::ubound: return "u-bound";
     case Outcome::drift: return "drift";
     case Outcome::mesh: return "mesh";
   }
@@ -116,8 +165,10 @@ const char* outcome_name(Outcome o) {
 struct Probe {
   Real dt = 0;
   Outcome outcome = Outcome::stable;
-  int steps = 0, target = 0;
-  Real t = 0, umax = 0, energy = 0, energy_max = 0, drift = 0, min_quality = 1, wall = 0, body_w = 0;
+  int steps = 0, target = 0, remeshes = 0;
+  Real t = 0, umax = 0, energy = 0, energy_max = 0, drift = 0, min_quality = 1, wall = 0, cpu = 0, body_w = 0,
+       body_x = 0,  // free body: the largest |x_g| over the run (0 for the exact flow)
+       max_ratio = 0;  // the largest E^{n+1}/E^n at the steps the energy test checked (0: none)
   std::string detail;
 };
 
@@ -149,17 +200,16 @@ std::pair<Real, Real> energy_and_umax(const Flow& flow) {
   return {0.5 * rho * E, umax};
 }
 
-template <class Scheme, class Pair = P1P1Gls>
-Probe probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool trace) {
-  if constexpr (std::is_same_v<Pair, P1P1Gls>)
-    if (s.taylor_hood) return probe<Scheme, TaylorHood>(mesh0, mu, dt, s, trace);
+template <class Scheme, class Pair, class Solver>
+Probe run_probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool trace) {
   const auto t0 = Clock::now();
+  const std::clock_t c0 = std::clock();
   Probe p;
   p.dt = dt;
   p.target = std::max(s.min_steps, int(std::ceil(s.T / dt - 1e-9)));
   // energy check from here on: n >= startup_steps and t >= 10 h^2 rho / mu (<= 1 s)
   const Real t_startup = std::min(1.0, 10 * s.h * s.h * rho / mu);
-  AleFlow<2, Pair, Scheme> flow(mesh0, FlowOptions{rho, mu, s.lin, 25, 1e-10});
+  AleFlow<2, Pair, Scheme, true, Solver> flow(mesh0, FlowOptions{rho, mu, s.lin, 25, 1e-10});
   auto rotation = [](const Vec<2>& x, Real) { return Vec<2>(-omega * x[1], omega * x[0]); };
   flow.set_velocity(tags::outer, rotation);
   if (s.free_body) {
@@ -168,13 +218,21 @@ Probe probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool trac
     body.tag = tags::inner;
     body.mass = s.rho_s * std::numbers::pi * R1 * R1;
     body.inertia = 0.5 * body.mass * R1 * R1;
+    if (s.remesh_quality > 0) body.radius = R1;  // a disk: kept on its circle by the adaptation
     flow.add_body(body);
+    if (s.remesh_quality > 0) {
+      RemeshOptions ro{.enabled = true, .trigger_quality = s.remesh_quality,
+                       .walls = {Circle{Vec<2>::Zero(), R2, tags::outer}}, .size = {}, .adapt = {}};
+      // --remesh-size: target size h, and the size band (|L - h| / h > 0.7) triggers too
+      if (s.remesh_size) ro.size = [h = s.h](const std::vector<Circle>&) { return uniform_size(h); };
+      flow.set_remeshing(std::move(ro));
+    }
   } else {
     flow.set_velocity(tags::inner, [](const Vec<2>&, Real) { return Vec<2>(Vec<2>::Zero()); });
     flow.set_mesh_velocity(tags::outer, rotation);
     if (s.rigid) flow.set_mesh_velocity(tags::inner, rotation);  // nodes slide along the fixed inner wall
   }
-  const std::vector<Index> outer = flow.mesh().boundary_nodes(tags::outer), inner = flow.mesh().boundary_nodes(tags::inner);
+  std::vector<Index> outer = flow.mesh().boundary_nodes(tags::outer), inner = flow.mesh().boundary_nodes(tags::inner);
   const Real max_drift = s.max_drift < 0 ? s.h : s.max_drift;
   // |u| <= omega R2 for this flow, so E <= E_cap = 1/2 rho |Omega| (omega R2)^2
   Real area = 0;
@@ -182,8 +240,10 @@ Probe probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool trac
   const Real E_cap = 0.5 * rho * area * wall_speed * wall_speed;
   Real E_prev = 0;
   for (int n = 0; n < p.target; ++n) {
+    StepReport rep;
+    const auto ts = Clock::now();
     try {
-      flow.step(dt);
+      rep = flow.step(dt);
     } catch (const MeshError& e) {
       p.outcome = Outcome::mesh, p.detail = e.what();
       break;
@@ -195,17 +255,26 @@ Probe probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool trac
     }
     p.steps = n + 1;
     p.t = flow.time();
+    p.remeshes = flow.stats().remeshes;
+    if (rep.remeshed)  // new node numbering
+      outer = flow.mesh().boundary_nodes(tags::outer), inner = flow.mesh().boundary_nodes(tags::inner);
     const auto [E, umax] = energy_and_umax(flow);
     p.umax = std::max(p.umax, umax);
     p.energy = E;
     p.energy_max = std::max(p.energy_max, E);
     for (Index v : outer) p.drift = std::max(p.drift, std::abs(flow.mesh().node(v).norm() - R2));
     for (Index v : inner) p.drift = std::max(p.drift, std::abs(flow.mesh().node(v).norm() - R1));
-    if (trace && (n < 12 || (n + 1) % std::max(1, p.target / 40) == 0)) {
+    if (trace && (n < 12 || (n + 1) % (s.trace_every > 0 ? s.trace_every : std::max(1, p.target / 40)) == 0)) {
       Real q = 1;
       for (Index c = 0; c < flow.mesh().n_cells(); ++c) q = std::min(q, flow.mesh().quality(c));
-      std::printf("    n=%4d t=%8.4f E=%.6e umax=%.4f E/Eprev=%.4f drift=%.2e minq=%.3f\n", n + 1, p.t, E, umax,
-                  E_prev > 0 ? E / E_prev : 0.0, p.drift, q);
+      std::printf("    n=%4d t=%8.4f E=%.6e umax=%.4f E/Eprev=%.4f drift=%.2e minq=%.3f w=%.5f |xg|=%.2e | %d it, %.2f s "
+                  "(mesh %.2f, asm %.2f, fact %.2f, solve %.2f)\n",
+                  n + 1, p.t, E, umax, E_prev > 0 ? E / E_prev : 0.0, p.drift, q,
+                  s.free_body ? flow.body_velocity(0)[2] : 0.0, s.free_body ? flow.body_centre(0).norm() : 0.0,
+                  rep.newton_iterations,
+                  std::chrono::duration<double>(Clock::now() - ts).count(), rep.t_mesh_velocity, rep.t_assembly,
+                  rep.t_factorize, rep.t_solve);
+      std::fflush(stdout);
     }
     if (!std::isfinite(E) || umax > 10 * wall_speed) {
       p.outcome = Outcome::blowup;
@@ -215,6 +284,7 @@ Probe probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool trac
     if (s.free_body) {
       const Real w = flow.body_velocity(0)[2];
       p.body_w = w;
+      p.body_x = std::max(p.body_x, flow.body_centre(0).norm());
       if (!std::isfinite(w) || std::abs(w) > 10 * omega) {
         p.outcome = Outcome::blowup;
         p.detail = "body w = " + std::to_string(w);
@@ -231,7 +301,14 @@ Probe probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool trac
       p.detail = "wall nodes " + std::to_string(p.drift) + " off their circle";
       break;
     }
-    if (n + 1 > s.startup_steps && p.t >= t_startup && E > 1.1 * E_prev) {
+    const bool after_startup = n + 1 > s.startup_steps && p.t >= t_startup;
+    if (s.u_bound > 0 && after_startup && umax > s.u_bound * wall_speed) {
+      p.outcome = Outcome::ubound;
+      p.detail = "max |u| = " + std::to_string(umax) + " > " + std::to_string(s.u_bound) + " x omega R2";
+      break;
+    }
+    if (after_startup) p.max_ratio = std::max(p.max_ratio, E / E_prev);
+    if (after_startup && E > 1.1 * E_prev) {
       p.outcome = Outcome::energy;
       p.detail = "E^{n+1}/E^n = " + std::to_string(E / E_prev);
       break;
@@ -240,7 +317,19 @@ Probe probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool trac
   }
   for (Index c = 0; c < flow.mesh().n_cells(); ++c) p.min_quality = std::min(p.min_quality, flow.mesh().quality(c));
   p.wall = std::chrono::duration<double>(Clock::now() - t0).count();
+  p.cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
   return p;
+}
+
+template <class Scheme>
+Probe probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool trace) {
+#ifdef ALEFSI_HAVE_SUITESPARSE
+  if (s.umfpack)
+    return s.taylor_hood ? run_probe<Scheme, TaylorHood, UmfPackLu>(mesh0, mu, dt, s, trace)
+                         : run_probe<Scheme, P1P1Gls, UmfPackLu>(mesh0, mu, dt, s, trace);
+#endif
+  return s.taylor_hood ? run_probe<Scheme, TaylorHood, SparseLu<>>(mesh0, mu, dt, s, trace)
+                       : run_probe<Scheme, P1P1Gls, SparseLu<>>(mesh0, mu, dt, s, trace);
 }
 
 struct Result {
@@ -251,13 +340,15 @@ struct Result {
   Probe first_unstable;     // the failing probe closest to the threshold
   Probe last_stable;
   int probes = 0;
-  double wall = 0;
+  double wall = 0, cpu = 0;
 };
 
 void print_probe(const Probe& p) {
-  std::printf("  dt=%.5f %-8s steps %4d/%-4d t=%7.3f umax=%.3f E=%.4e Emax=%.4e drift=%.1e minq=%.3f w=%.4f (%.1f s)%s%s\n",
+  std::printf("  dt=%.5f %-8s steps %4d/%-4d t=%7.3f umax=%.3f E=%.4e Emax=%.4e drift=%.1e minq=%.3f w=%.4f |xg|=%.1e Er=%.3f%s "
+              "(%.1f s wall, %.1f s CPU)%s%s\n",
               p.dt, outcome_name(p.outcome), p.steps, p.target, p.t, p.umax, p.energy, p.energy_max, p.drift,
-              p.min_quality, p.body_w, p.wall,
+              p.min_quality, p.body_w, p.body_x, p.max_ratio, p.remeshes > 0 ? (" remeshes=" + std::to_string(p.remeshes)).c_str() : "",
+              p.wall, p.cpu,
               p.detail.empty() ? "" : "  ", p.detail.c_str());
   std::fflush(stdout);
 }
@@ -271,6 +362,7 @@ Result bisect(const Mesh<2>& mesh, Real mu, const Settings& s) {
   auto run = [&](Real dt) {
     ++r.probes;
     Probe p = probe<Scheme>(mesh, mu, dt, s, false);
+    r.cpu += p.cpu;
     print_probe(p);
     return p;
   };
@@ -345,6 +437,13 @@ int main(int argc, char** argv) {
       for (const auto& m : split(next())) mus.push_back(std::atof(m.c_str()));
     } else if (a == "--T") s.T = std::atof(next().c_str()), T_set = true;
     else if (a == "--min-steps") s.min_steps = std::atoi(next().c_str()), min_steps_set = true;
+    else if (a == "--startup-steps") s.startup_steps = std::atoi(next().c_str());
+    else if (a == "--remesh") s.remesh_quality = std::atof(next().c_str());
+    else if (a == "--remesh-size") s.remesh_size = true;
+    else if (a == "--probes") {
+      s.probe_dts.clear();
+      for (const auto& d : split(next())) s.probe_dts.push_back(std::atof(d.c_str()));
+    }
     else if (a == "--inner") {
       const std::string m = next();
       if (m != "fixed" && m != "free") {
@@ -361,6 +460,20 @@ int main(int argc, char** argv) {
       }
       s.taylor_hood = m == "th";
     }
+    else if (a == "--solver") {
+      const std::string m = next();
+      if (m != "sparselu" && m != "umfpack") {
+        std::fprintf(stderr, "--solver sparselu|umfpack\n");
+        return 2;
+      }
+#ifndef ALEFSI_HAVE_SUITESPARSE
+      if (m == "umfpack") {
+        std::fprintf(stderr, "--solver umfpack: built without SuiteSparse (ALEFSI_HAVE_SUITESPARSE)\n");
+        return 2;
+      }
+#endif
+      s.umfpack = m == "umfpack";
+    }
     else if (a == "--dt-lo") s.dt_lo = std::atof(next().c_str());
     else if (a == "--dt-hi") s.dt_hi = std::atof(next().c_str());
     else if (a == "--tol") s.tol = std::atof(next().c_str());
@@ -373,8 +486,10 @@ int main(int argc, char** argv) {
       s.lin = l == "newton" ? Linearisation::newton : Linearisation::semi_implicit;
     } else if (a == "--csv") csv = next();
     else if (a == "--energy-bound") s.energy_bound = std::atof(next().c_str());
+    else if (a == "--u-bound") s.u_bound = std::atof(next().c_str());
     else if (a == "--max-drift") s.max_drift = std::atof(next().c_str());
     else if (a == "--trace") s.trace_dt = std::atof(next().c_str());
+    else if (a == "--trace-every") s.trace_every = std::atoi(next().c_str());
     else if (a == "--mesh-motion") {
       const std::string m = next();
       if (m != "shear" && m != "rigid") {
@@ -388,7 +503,9 @@ int main(int argc, char** argv) {
                    "usage: %s [--schemes MR_AB,BDF2_BDF2E,BDF2_AB,BDF3_BDF3E,BSS] [--h H] [--mu M1,M2] [--T T]\n"
                    "          [--min-steps N] [--dt-lo DT] [--dt-hi DT] [--tol REL] [--lin newton|semi] [--csv FILE]\n"
                    "          [--mesh-motion shear|rigid] [--max-drift D] [--energy-bound F]\n"
-                   "          [--trace DT] [--inner fixed|free] [--rho-s R] [--pair gls|th]\n",
+                   "          [--trace DT] [--inner fixed|free] [--rho-s R] [--pair gls|th] [--solver sparselu|umfpack]\n"
+                   "          [--startup-steps N] [--probes DT1,DT2,...] [--remesh Q] [--remesh-size] [--u-bound F]\n"
+                   "          [--trace-every N]\n",
                    argv[0]);
       return 2;
     }
@@ -397,7 +514,12 @@ int main(int argc, char** argv) {
     if (!T_set) s.T = 1;
     if (!min_steps_set) s.min_steps = 5;
   }
-  if (!(s.h > 0) || !(s.dt_lo > 0) || !(s.dt_hi > s.dt_lo) || !(s.tol > 0) || mus.empty()) {
+  if (s.remesh_quality != 0 && !(s.free_body && s.remesh_quality > 0 && s.remesh_quality < 1)) {
+    std::fprintf(stderr, "--remesh Q: needs --inner free and 0 < Q < 1\n");
+    return 2;
+  }
+  if (!(s.h > 0) || !(s.dt_lo > 0) || !(s.dt_hi > s.dt_lo) || !(s.tol > 0) || mus.empty() || s.startup_steps < 0 ||
+      std::any_of(s.probe_dts.begin(), s.probe_dts.end(), [](Real d) { return !(d > 0); })) {
     std::fprintf(stderr, "invalid settings\n");
     return 2;
   }
@@ -417,8 +539,9 @@ int main(int argc, char** argv) {
                 s.h, long(mesh.n_nodes()), long(mesh.n_cells()), long(3 * mesh.n_nodes()),
                 std::chrono::duration<double>(Clock::now() - tm).count());
     if (s.free_body)
-      std::printf("inner cylinder: FREE rigid body, rho_s = %g (I = %.4g); outer-wall mesh velocity 0; pair %s\n",
-                  s.rho_s, 0.5 * s.rho_s * std::numbers::pi * std::pow(R1, 4), s.taylor_hood ? "P2/P1" : "P1/P1-GLS");
+      std::printf("inner cylinder: FREE rigid body, rho_s = %g (I = %.4g); outer-wall mesh velocity 0\n", s.rho_s,
+                  0.5 * s.rho_s * std::numbers::pi * std::pow(R1, 4));
+    std::printf("pair %s, linear solver %s\n", s.taylor_hood ? "P2/P1" : "P1/P1-GLS", s.umfpack ? "UMFPACK" : "SparseLU");
     std::printf("omega=%g, rho=%g, %s, mesh motion %s, run to max(T=%g, %d steps), start-up %d steps, max drift %g, "
                 "bisection tol %g%%\n",
                 omega, rho, s.lin == Linearisation::newton ? "Newton" : "semi-implicit", s.free_body ? "elastic (free body)" : s.rigid ? "rigid" : "shear", s.T,
@@ -431,11 +554,28 @@ int main(int argc, char** argv) {
         }
       return 0;
     }
+    if (!s.probe_dts.empty()) {
+      std::vector<std::string> rows;
+      for (Real mu : mus)
+        for (const auto* e : chosen)
+          for (Real dt : s.probe_dts) {
+            std::printf("%s, mu = %g:\n", e->key, mu);
+            const Probe p = e->probe(mesh, mu, dt, s, false);
+            print_probe(p);
+            char row[256];
+            std::snprintf(row, sizeof row, "| %s | %g | %g | %s | %d/%d | %.3f | %.3f | %.3f | %.0f |", e->key, mu, dt,
+                          outcome_name(p.outcome), p.steps, p.target, p.t, p.umax, p.min_quality, p.cpu);
+            rows.push_back(row);
+          }
+      std::printf("\n| scheme | mu | dt | outcome | steps | t reached | max abs u | min quality | CPU (s) |\n|---|---|---|---|---|---|---|---|---|\n");
+      for (const auto& r : rows) std::printf("%s\n", r.c_str());
+      return 0;
+    }
     std::vector<Result> results;
     for (Real mu : mus)
       for (const auto* e : chosen) results.push_back(e->bisect(mesh, mu, s));
-    std::printf("\n| scheme | mu | largest stable dt | first unstable dt (reason, at t) | wall drift at dt_max | probes | time (s) |\n");
-    std::printf("|---|---|---|---|---|---|---|\n");
+    std::printf("\n| scheme | mu | largest stable dt | first unstable dt (reason, at t) | wall drift at dt_max | probes | wall (s) | CPU (s) |\n");
+    std::printf("|---|---|---|---|---|---|---|---|\n");
     for (const auto& r : results) {
       char fu[160] = "-";
       if (r.first_unstable.dt > 0)
@@ -443,18 +583,18 @@ int main(int argc, char** argv) {
                       r.first_unstable.t);
       char dr[32] = "-";
       if (r.last_stable.dt > 0) std::snprintf(dr, sizeof dr, "%.1e", r.last_stable.drift);
-      std::printf("| %s | %g | %s | %s | %s | %d | %.0f |\n", r.scheme.c_str(), r.mu, r.dt_max.c_str(), fu, dr, r.probes,
-                  r.wall);
+      std::printf("| %s | %g | %s | %s | %s | %d | %.0f | %.0f |\n", r.scheme.c_str(), r.mu, r.dt_max.c_str(), fu, dr,
+                  r.probes, r.wall, r.cpu);
     }
     if (!csv.empty()) {
       std::ofstream f(csv);
       f << "scheme,inner,rho_s,mu,h,linearisation,dt_max,bracket_lo,bracket_hi,first_unstable_reason,first_unstable_t,"
-           "drift_at_dt_max,probes,wall_s\n";
+           "drift_at_dt_max,probes,wall_s,cpu_s\n";
       for (const auto& r : results)
         f << r.scheme << ',' << (s.free_body ? "free" : "fixed") << ',' << (s.free_body ? s.rho_s : 0.0) << ',' << r.mu << ',' << s.h << ',' << (s.lin == Linearisation::newton ? "Newton" : "semi-implicit")
           << ',' << r.dt_max << ',' << r.lo << ',' << r.hi << ','
           << (r.first_unstable.dt > 0 ? outcome_name(r.first_unstable.outcome) : "") << ',' << r.first_unstable.t << ','
-          << r.last_stable.drift << ',' << r.probes << ',' << r.wall << '\n';
+          << r.last_stable.drift << ',' << r.probes << ',' << r.wall << ',' << r.cpu << '\n';
       std::printf("wrote %s\n", csv.c_str());
     }
   } catch (const std::exception& e) {

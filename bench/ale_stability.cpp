@@ -209,7 +209,7 @@ Probe run_probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool 
   p.target = std::max(s.min_steps, int(std::ceil(s.T / dt - 1e-9)));
   // energy check from here on: n >= startup_steps and t >= 10 h^2 rho / mu (<= 1 s)
   const Real t_startup = std::min(1.0, 10 * s.h * s.h * rho / mu);
-  AleFlow<2, Pair, Scheme, true, Solver> flow(mesh0, FlowOptions{rho, mu, s.lin, 25, 1e-10});
+  AleFlow<FlowConfig<2, Pair, Scheme, NavierStokes, Solver>> flow(mesh0, FlowOptions{rho, mu, s.lin, 25, 1e-10});
   auto rotation = [](const Vec<2>& x, Real) { return Vec<2>(-omega * x[1], omega * x[0]); };
   flow.set_velocity(tags::outer, rotation);
   if (s.free_body) {

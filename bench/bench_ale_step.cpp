@@ -109,7 +109,7 @@ Mesh<D> unit_mesh(int n) {
 
 // Sets up the manufactured-solution problem on a moving mesh (one wall sliding, elasticity).
 template <int D, class Pair, class Scheme>
-void setup_mms(AleFlow<D, Pair, Scheme>& flow, const Exact<D, Pair>& ex) {
+void setup_mms(AleFlow<FlowConfig<D, Pair, Scheme>>& flow, const Exact<D, Pair>& ex) {
   for (int t = 1; t <= 2 * D; ++t) flow.set_velocity(t, Exact<D, Pair>::u);
   const int wall = D == 2 ? tags::bottom : tags::zmin;
   flow.set_mesh_velocity(wall, [](const Vec<D>& x, Real t) {
@@ -123,7 +123,7 @@ void setup_mms(AleFlow<D, Pair, Scheme>& flow, const Exact<D, Pair>& ex) {
 }
 
 template <int D, class Pair, class Scheme>
-Real velocity_error(const AleFlow<D, Pair, Scheme>& flow) {
+Real velocity_error(const AleFlow<FlowConfig<D, Pair, Scheme>>& flow) {
   using Ex = Exact<D, Pair>;
   const Real T = flow.time();
   const auto e = flow_errors<D, Pair>(
@@ -175,7 +175,7 @@ StepRow run_steps(int n, Linearisation lin, int measured, Real dt) {
   row.measured = measured;
   const Exact<D, Pair> ex{1.0, 0.01};
   auto t0 = Clock::now();
-  AleFlow<D, Pair, BDF2_BDF2E> flow(unit_mesh<D>(n), FlowOptions{ex.rho, ex.mu, lin, 25, 1e-10});
+  AleFlow<FlowConfig<D, Pair, BDF2_BDF2E>> flow(unit_mesh<D>(n), FlowOptions{ex.rho, ex.mu, lin, 25, 1e-10});
   setup_mms(flow, ex);
   row.t_setup = seconds_since(t0);
   row.cells = flow.mesh().n_cells();
@@ -281,7 +281,7 @@ ErrRow run_error(int steps, Linearisation lin, int repeats) {
   row.steps = steps, row.dt = dt, row.wall = 1e300;
   for (int r = 0; r < repeats; ++r) {
     const auto t0 = Clock::now();
-    AleFlow<D, Pair, Scheme> flow(rectangle_mesh(4, 4), FlowOptions{ex.rho, ex.mu, lin, 25, 1e-12});
+    AleFlow<FlowConfig<D, Pair, Scheme>> flow(rectangle_mesh(4, 4), FlowOptions{ex.rho, ex.mu, lin, 25, 1e-12});
     setup_mms(flow, ex);
     long its = 0;
     for (int n = 0; n < steps; ++n) its += flow.step(dt).newton_iterations;

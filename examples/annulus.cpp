@@ -49,12 +49,9 @@
 #include <cmath>
 #include <ctime>
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <numbers>
-#include <set>
-#include <sstream>
 #include <utility>
 #include <string>
 #include <vector>
@@ -67,15 +64,10 @@ namespace {
 
 // --- the linear solver ---------------------------------------------------------------------------
 // The sweeps factorise Taylor-Hood saddle-point matrices of 2e4-1e5 unknowns thousands of times:
-// UMFPACK with its symmetric strategy (la/suitesparse.hpp, when alefsi was built with
-// SuiteSparse) or else the library's default SparseLU with the saddle-point AMD ordering
-// (docs/solvers.md: both within 1.5x of each other; COLAMD was 10x slower).
-#ifdef ALEFSI_HAVE_SUITESPARSE
-using Solver = UmfPackLu;
-#else
-using Solver = SparseLu<>;
-#endif
-static_assert(LinearSolver<Solver>, "the annulus example's solver must model LinearSolver");
+// DefaultDirectSolver is UMFPACK with its symmetric strategy when alefsi was built with
+// SuiteSparse, else SparseLU with the saddle-point AMD ordering (docs/solvers.md: both within
+// 1.5x of each other; COLAMD was 10x slower).
+using Solver = DefaultDirectSolver;
 
 // --- the set-up ------------------------------------------------------------------------------
 struct Scene {
@@ -89,9 +81,12 @@ struct Scene {
   int damped_start = 0;  // FlowOptions::damped_start: 0 = the multistep start-up, M = M backward-Euler substeps
   bool convection = true;  // false: unsteady Stokes (a diagnostic: no advection of start-up errors)
   Real omega2(Real t) const { return ramp > 0 ? 1 - std::exp(-std::pow(t / ramp, 4)) : 1.0; }
-  Real mass() const { return rho_s * pi * r1 * r1; }
-  Real inertia() const { return 0.5 * mass() * r1 * r1; }  // = rho_s pi R1^4 / 2
-  Real ihat() const { return inertia() / (2 * pi * rho * r1 * r1 * r2 * r2); }  // = rho_s / 64
+  // the physical set-up (alefsi/scenes/annulus.hpp)
+  scenes::Annulus annulus() const {
+    return {.r1 = r1, .r2 = r2, .rho_s = rho_s, .omega = [s = *this](Real t) { return s.omega2(t); }};
+  }
+  Real inertia() const { return annulus().inner_body().inertia; }  // = rho_s pi R1^4 / 2
+  Real ihat() const { return annulus().inertia_ratio(rho); }       // = rho_s / 64
   reference::AnnulusProblem fd_problem() const {
     reference::AnnulusProblem p;
     p.r1 = r1, p.r2 = r2, p.rho = rho, p.mu = mu, p.inertia = inertia();
@@ -109,32 +104,17 @@ struct Settings {
   Linearisation lin = Linearisation::newton;
 };
 
-Mesh<2> make_mesh(const Scene& sc, const Settings& s) {
-  if (s.h_wall <= 0) return annulus_unstructured(sc.r1, sc.r2, s.h);
-  Domain2D dom{Circle{Vec<2>::Zero(), sc.r2, tags::outer}, {Circle{Vec<2>::Zero(), sc.r1, tags::inner}}};
-  const Real H = s.h, hw = s.h_wall, R2 = sc.r2;
-  return generate_mesh(dom, MesherOptions{[H, hw, R2](const Vec<2>& x) { return std::min(H, hw + 0.25 * (R2 - x.norm())); }});
-}
+Mesh<2> make_mesh(const Scene& sc, const Settings& s) { return sc.annulus().mesh(s.h, s.h_wall); }
 
 // --- one FEM run -------------------------------------------------------------------------------
 // Advances n steps of dt and calls obs(flow, step, report) after each; rigid inner body, driven outer wall.
 template <class Pair, class Scheme, bool Convection, class Obs>
 void simulate_with(const Mesh<2>& mesh, const Scene& sc, Real dt, int n, Linearisation lin, Obs&& obs) {
-  AleFlow<2, Pair, Scheme, Convection, Solver> flow(mesh, FlowOptions{sc.rho, sc.mu, lin, 25, 1e-10, sc.damped_start});
-  flow.set_velocity(tags::outer, [sc](const Vec<2>& x, Real t) { return Vec<2>(sc.omega2(t) * Vec<2>(-x[1], x[0])); });
-  RigidBody2D body;
-  body.tag = tags::inner;
-  body.mass = sc.mass();
-  body.inertia = sc.inertia();
-  flow.add_body(body);
-  if (sc.wall_moving_at_0 && sc.omega2(0) != 0) {
-    std::set<std::pair<Real, Real>> wall;  // positions of the outer wall's velocity DOFs
-    const auto& vel = flow.space().velocity();
-    for (Index i : vel.boundary_dofs(tags::outer)) wall.emplace(vel.point(i)[0], vel.point(i)[1]);
-    flow.set_initial_velocity([&](const Vec<2>& x) {
-      return wall.count({x[0], x[1]}) ? Vec<2>(sc.omega2(0) * Vec<2>(-x[1], x[0])) : Vec<2>(Vec<2>::Zero());
-    });
-  }
+  using Equations = std::conditional_t<Convection, NavierStokes, UnsteadyStokes>;
+  AleFlow<FlowConfig<2, Pair, Scheme, Equations, Solver>> flow(mesh, FlowOptions{sc.rho, sc.mu, lin, 25, 1e-10, sc.damped_start});
+  const scenes::Annulus an = sc.annulus();
+  an.configure(flow);
+  if (sc.wall_moving_at_0 && sc.omega2(0) != 0) an.start_with_moving_wall(flow);
   for (int k = 1; k <= n; ++k) {
     const StepReport rep = flow.step(dt);
     obs(flow, k, rep);
@@ -174,24 +154,15 @@ Real error_vs_field(const Flow& flow, const VecX& ref) {
 template <class F>
 void with_types(const std::string& pair, const std::string& scheme, F&& f) {
   auto pick = [&]<class Pair>() {
-    if (scheme == "MR_AB") f.template operator()<Pair, MR_AB>();
-    else if (scheme == "BDF2_BDF2E") f.template operator()<Pair, BDF2_BDF2E>();
-    else if (scheme == "BDF2_AB") f.template operator()<Pair, BDF2_AB>();
-    else if (scheme == "BDF3_BDF3E") f.template operator()<Pair, BDF3_BDF3E>();
-    else if (scheme == "BSS") f.template operator()<Pair, BSS>();
-    else throw InvalidArgument("scheme", "unknown scheme " + scheme);
+    dispatch_scheme(scheme, [&]<class Scheme>() { f.template operator()<Pair, Scheme>(); }, "--schemes");
   };
   if (pair == "th") pick.template operator()<TaylorHood>();
   else if (pair == "gls") pick.template operator()<P1P1Gls>();
-  else throw InvalidArgument("pair", "th or gls, got " + pair);
+  else throw InvalidArgument("--pair", "th or gls, got " + pair);
 }
 
 const char* display_name(const std::string& key) {
-  if (key == "MR_AB") return MR_AB::name;
-  if (key == "BDF2_BDF2E") return BDF2_BDF2E::name;
-  if (key == "BDF2_AB") return BDF2_AB::name;
-  if (key == "BDF3_BDF3E") return BDF3_BDF3E::name;
-  return BSS::name;
+  return dispatch_scheme(key, []<class S>() { return S::name; }, "--schemes");
 }
 
 // The paper's Table 1 (E at t = 0.8, dt = 0.05 2^-k); BSS is not in the table.
@@ -425,73 +396,57 @@ int figure7(const Scene& base, const Settings& s) {
   return 0;
 }
 
-std::vector<std::string> split(const std::string& str) {
-  std::vector<std::string> out;
-  std::stringstream ss(str);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 }  // namespace
 
-int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: %s table1|smooth|speed|fig7 [options] (see the file comment)\n", argv[0]);
-    return 2;
-  }
+int main(int argc, char** argv) try {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress of long sweeps under nohup
-  const std::string mode = argv[1];
+  // the mode sets the defaults of the other options
+  std::string mode = argc > 1 ? argv[1] : "table1";
   Scene sc;
   Settings s;
   if (mode == "smooth") sc.mu = 1, sc.ramp = 0.1, s.T = 0.4, s.dt0 = 0.02, s.h = 0.05;
   if (mode == "speed") sc.mu = 1, sc.ramp = 0.1, s.T = 0.4, s.dt0 = 0.02, s.h = 0.08;
   if (mode == "fig7") sc.mu = 1, s.schemes = {"MR_AB"};
-  std::vector<Linearisation> lins = {Linearisation::newton, Linearisation::semi_implicit};
-  for (int i = 2; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (i + 1 >= argc) {
-      std::fprintf(stderr, "%s needs a value\n", a.c_str());
-      return 2;
-    }
-    const std::string v = argv[++i];
-    if (a == "--schemes" || a == "--scheme") s.schemes = split(v);
-    else if (a == "--pair") s.pair = v;
-    else if (a == "--h") s.h = std::atof(v.c_str());
-    else if (a == "--h-wall") s.h_wall = std::atof(v.c_str());
-    else if (a == "--kmax") s.kmax = std::atoi(v.c_str());
-    else if (a == "--kref") s.kref = std::atoi(v.c_str());
-    else if (a == "--ref-scheme") s.ref_scheme = v;
-    else if (a == "--lin") s.lin = v == "semi" ? Linearisation::semi_implicit : Linearisation::newton;
-    else if (a == "--lins") {
-      lins.clear();
-      for (const auto& l : split(v)) lins.push_back(l == "semi" ? Linearisation::semi_implicit : Linearisation::newton);
-    }
-    else if (a == "--csv") s.csv = v;
-    else if (a == "--mu") sc.mu = std::atof(v.c_str());
-    else if (a == "--rho-s") sc.rho_s = std::atof(v.c_str());
-    else if (a == "--ramp") sc.ramp = std::atof(v.c_str());
-    else if (a == "--T") s.T = std::atof(v.c_str());
-    else if (a == "--dt0") s.dt0 = std::atof(v.c_str());
-    else if (a == "--dt") s.dt = std::atof(v.c_str());
-    else if (a == "--wall-start") sc.wall_moving_at_0 = v != "rest";
-    else if (a == "--damped-start") sc.damped_start = std::atoi(v.c_str());
-    else if (a == "--convection") sc.convection = v != "off";
-    else {
-      std::fprintf(stderr, "unknown option %s\n", a.c_str());
-      return 2;
-    }
-  }
-  try {
-    if (mode == "table1") return time_orders(sc, s, true);
-    if (mode == "smooth") return time_orders(sc, s, false);
-    if (mode == "speed") return speed_error(sc, s, lins);
-    if (mode == "fig7") return figure7(sc, s);
-    std::fprintf(stderr, "unknown mode %s\n", mode.c_str());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  }
+  std::string lin = "newton", wall_start = sc.wall_moving_at_0 ? "moving" : "rest", convection = "on";
+  std::vector<std::string> lins = {"newton", "semi"};
+  Options opt("annulus", "The paper's annulus (section 6.3); modes table1, smooth, speed, fig7 (see the file comment).");
+  opt.positional("mode", mode, "table1 | smooth | speed | fig7")
+      .add("schemes", s.schemes, "schemes, comma-separated (" + scheme_names() + ")")
+      .add("pair", s.pair, "th (P2/P1) or gls (P1/P1-GLS)")
+      .add("h", s.h, "mesh size")
+      .add("h-wall", s.h_wall, "mesh size at the outer wall (0: uniform h)")
+      .add("kmax", s.kmax, "dt = dt0 2^-k, k = 0..kmax")
+      .add("kref", s.kref, "the fine-dt FEM reference at dt0 2^-kref (-1: kmax + 3)")
+      .add("ref-scheme", s.ref_scheme, "scheme of the fine-dt FEM reference")
+      .add("lin", lin, "newton or semi (table1, smooth, fig7)")
+      .add("lins", lins, "linearisations of the speed study")
+      .add("csv", s.csv, "CSV file of the results")
+      .add("mu", sc.mu, "viscosity")
+      .add("rho-s", sc.rho_s, "density of the inner cylinder")
+      .add("ramp", sc.ramp, "smooth start omega_2 = 1 - exp(-(t/ramp)^4); 0: impulsive")
+      .add("T", s.T, "final time")
+      .add("dt0", s.dt0, "largest time step of the sweeps")
+      .add("dt", s.dt, "time step (fig7)")
+      .add("wall-start", wall_start, "the initial FE velocity on the outer wall: moving or rest")
+      .add("damped-start", sc.damped_start, "the first step as M backward-Euler substeps (0: multistep start-up)")
+      .add("convection", convection, "on, or off (unsteady Stokes: a diagnostic)");
+  if (!opt.parse(argc, argv, std::cout)) return 0;
+  opt.print(std::cout);
+  auto linearisation = [](const std::string& l) {
+    if (l != "newton" && l != "semi") throw InvalidArgument("--lin", "newton or semi, got " + l);
+    return l == "semi" ? Linearisation::semi_implicit : Linearisation::newton;
+  };
+  s.lin = linearisation(lin);
+  std::vector<Linearisation> lin_list;
+  for (const auto& l : lins) lin_list.push_back(linearisation(l));
+  sc.wall_moving_at_0 = wall_start != "rest";
+  sc.convection = convection != "off";
+  if (mode == "table1") return time_orders(sc, s, true);
+  if (mode == "smooth") return time_orders(sc, s, false);
+  if (mode == "speed") return speed_error(sc, s, lin_list);
+  if (mode == "fig7") return figure7(sc, s);
+  throw InvalidArgument("mode", "table1, smooth, speed or fig7, got " + mode);
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "annulus: %s\n", e.what());
+  return 1;
 }

@@ -17,10 +17,10 @@
 //
 // Configuration: element pair and scheme at compile time (CMake options ALEFSI_DKT_PAIR =
 // P1P1Gls | TaylorHood, ALEFSI_DKT_SCHEME = BDF2_BDF2E | BDF3_BDF3E | MR_AB | BDF2_AB | BSS;
-// default P1P1Gls + BDF2_BDF2E as in the paper's Figure 5); at run time:
-//   ./dkt [--dt 1e-3] [--t-end 0.5] [--h-body 0.02] [--h-far 0.15] [--offset 0.001]
-//         [--spring-range 0.04] [--output DIR] [--vtu-every N] [--checkpoint-every N]
-//         [--newton] [--restart FILE] [--no-collisions] [--no-remeshing] [--threads T]
+// default P1P1Gls + BDF2_BDF2E as in the paper's Figure 5); the scene is
+// alefsi/scenes/settling.hpp's; at run time (`./dkt --help` lists every option with its
+// default): --dt, --t-end, --h-body, --h-far, --offset, --spring-range, --output, --vtu-every,
+// --checkpoint-every, --threads, --restart FILE, --newton, --no-collisions, --no-remeshing.
 // --threads T: the flow system is assembled on T threads (FlowOptions::threads; the
 // results are the same to the last bit, only the assembly time changes).
 // What it prints: the mesh size, then a progress line every 10 steps (t, dt, Newton
@@ -37,11 +37,9 @@
 
 #include <array>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
-#include <numbers>
 #include <string>
 
 #ifndef ALEFSI_DKT_PAIR
@@ -52,73 +50,55 @@
 #endif
 
 using namespace alefsi;
-// SparseLU with the saddle-point AMD ordering: on this scene's ~10^4 unknowns it factorises as
-// fast as UMFPACK and solves 7x faster (no iterative refinement); docs/results.md
-using Solver = SparseLu<>;
-using Flow = AleFlow<2, ALEFSI_DKT_PAIR, ALEFSI_DKT_SCHEME, true, Solver>;
+// SparseLU with the saddle-point AMD ordering (FlowConfig's default): on this scene's ~10^4
+// unknowns it factorises as fast as UMFPACK and solves 7x faster (no iterative refinement);
+// docs/results.md
+using Config = FlowConfig<2, ALEFSI_DKT_PAIR, ALEFSI_DKT_SCHEME>;
+using Flow = AleFlow<Config>;
 
 int main(int argc, char** argv) try {
   Real dt = 1e-3, t_end = 0.5, h_body = 0.02, h_far = 0.15, offset = 0.001, spring_range = 0.04;
   std::filesystem::path out = "output/dkt", restart;
   int vtu_every = 50, checkpoint_every = 100, threads = 1;
   bool newton = false, collisions = true, remeshing = true;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto num = [&] {
-      if (i + 1 >= argc) throw InvalidArgument(a, "needs a value");
-      return std::atof(argv[++i]);
-    };
-    if (a == "--dt") dt = num();
-    else if (a == "--t-end") t_end = num();
-    else if (a == "--h-body") h_body = num();
-    else if (a == "--h-far") h_far = num();
-    else if (a == "--offset") offset = num();
-    else if (a == "--spring-range") spring_range = num();
-    else if (a == "--vtu-every") vtu_every = int(num());
-    else if (a == "--checkpoint-every") checkpoint_every = int(num());
-    else if (a == "--threads") threads = int(num());
-    else if (a == "--output" && i + 1 < argc) out = argv[++i];
-    else if (a == "--restart" && i + 1 < argc) restart = argv[++i];
-    else if (a == "--newton") newton = true;
-    else if (a == "--no-collisions") collisions = false;
-    else if (a == "--no-remeshing") remeshing = false;
-    else {
-      std::cerr << "usage: " << argv[0]
-                << " [--dt S] [--t-end S] [--h-body CM] [--h-far CM] [--offset CM] [--spring-range CM]"
-                   " [--output DIR] [--vtu-every N] [--checkpoint-every N] [--newton] [--restart FILE] [--no-collisions] [--no-remeshing]"
-                   " [--threads T]\n";
-      return 2;
-    }
-  }
+  Options opt("dkt", "Drafting, kissing and tumbling of two disks settling in a 2 x 6 cm channel (paper 6.2).");
+  opt.add("dt", dt, "time step (s)")
+      .add("t-end", t_end, "final time (s)")
+      .add("h-body", h_body, "mesh size at the disks (cm)")
+      .add("h-far", h_far, "mesh size far from the disks (cm)")
+      .add("offset", offset, "the upper disk's leftward shift (cm)")
+      .add("spring-range", spring_range, "range of the collision spring (cm)")
+      .add("output", out, "folder for bodies.csv, flow.pvd, checkpoint.bin")
+      .add("vtu-every", vtu_every, "VTU output every N steps (0: none)")
+      .add("checkpoint-every", checkpoint_every, "checkpoint every N steps (0: none)")
+      .add("threads", threads, "assembly threads (results are the same to the last bit)")
+      .add("restart", restart, "continue from this checkpoint")
+      .flag("newton", newton, "Newton's method instead of the semi-implicit linearisation")
+      .flag("collisions", collisions, "collision forces (eq. 24 + spring)")
+      .flag("remeshing", remeshing, "remeshing in the time loop");
+  if (!opt.parse(argc, argv, std::cout)) return 0;
+  opt.print(std::cout);
   // --- the scene ------------------------------------------------------------------------
-  const Real W = 2, H = 6, R = 0.125, rho_s = 1.5, rho_f = 1, mu = 0.01;
-  const Vec<2> g(0, -980);
-  const int upper = 5, lower = 6;
-  const std::vector<Circle> disks = {{Vec<2>(1 - offset, 5), R, upper}, {Vec<2>(1, 4.5), R, lower}};
-  Mesh<2> mesh = restart.empty() ? channel_with_disks(W, H, disks, h_body, h_far) : read_checkpoint_mesh<2>(restart);
-  std::cout << "DKT with " << Flow::Space::VelocityElement::degree << "/1 elements ("
-            << ALEFSI_DKT_PAIR::name << "), " << ALEFSI_DKT_SCHEME::name << ", " << Solver::name << ", dt " << dt
-            << ", offset " << offset << ", spring range " << spring_range << ": "
-            << mesh.n_nodes()
-            << " nodes, " << mesh.n_cells() << " triangles\n";
-
-  Flow flow(std::move(mesh), {.rho = rho_f, .mu = mu,
-                              .linearisation = newton ? Linearisation::newton : Linearisation::semi_implicit,
-                              .threads = threads});
-  for (int tag : {tags::bottom, tags::right, tags::top, tags::left})
-    flow.set_velocity(tag, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });
-  for (const Circle& c : disks) flow.add_body(disk_body(c.tag, c.centre, R, rho_s));
-  flow.set_gravity(g);
+  scenes::SettlingDisks scene = scenes::SettlingDisks::dkt(offset);
   // eq. (24) with delta = R/10, plus the Glowinski spring with a force at contact of 50 net
   // weights: it keeps the disks apart (collision.hpp). Its range is a model parameter, fixed
   // (default 0.04 cm = 2 h_body at the default mesh; take it >= h_body). Tied to h_body (as
   // before), it changed the model with the mesh: at h_body = 0.04 the range 0.08 instead of
   // 0.04 moves the disks at t = 0.3 s by up to 1 cm (docs/results.md)
-  const Real net_weight = (rho_s - rho_f) * std::numbers::pi * R * R * g.norm();
-  if (collisions) flow.set_collisions({.range = 0.1, .spring_range = spring_range, .spring_force = 50 * net_weight});
-  flow.set_remeshing({.enabled = remeshing,.walls = {channel_outline(W, H)},
-                      .size = [=](const std::vector<Circle>& now) { return graded_size(now, h_body, h_far); },
-                      .adapt = {}});
+  scene.spring_range = spring_range;
+  scene.collisions = collisions;
+  scene.remeshing = remeshing;
+  const Real R = scene.disks[0].radius;
+  Mesh<2> mesh = restart.empty() ? scene.mesh(h_body, h_far) : read_checkpoint_mesh<2>(restart);
+  std::cout << "DKT with " << Flow::Space::VelocityElement::degree << "/1 elements (" << Config::Pair::name << "), "
+            << Config::Scheme::name << ", " << Config::Solver::name << ", dt " << dt << ", offset " << offset
+            << ", spring range " << spring_range << ": " << mesh.n_nodes() << " nodes, " << mesh.n_cells()
+            << " triangles\n";
+
+  Flow flow(std::move(mesh), {.rho = scene.rho_f, .mu = 0.01,
+                              .linearisation = newton ? Linearisation::newton : Linearisation::semi_implicit,
+                              .threads = threads});
+  scene.configure(flow, h_body, h_far);
   if (!restart.empty()) {
     flow.load_checkpoint(restart);
     std::cout << "restarted from " << restart << " at t = " << flow.time() << "\n";

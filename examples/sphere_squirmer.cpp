@@ -67,7 +67,7 @@ using Solver = UmfPackLu;  // la/suitesparse.hpp: multifrontal LU, symmetric str
 #else
 using Solver = SparseLu<>;
 #endif
-using Flow = AleFlow<3, TaylorHood, BSS, false, Solver>;
+using Flow = AleFlow<FlowConfig<3, TaylorHood, BSS, UnsteadyStokes, Solver>>;
 
 namespace {
 constexpr Real R = 0.25;

@@ -79,7 +79,7 @@ Result swim(Mesh<2> mesh, const Vec<2>& c, const std::vector<int>& walls) {
   Result res;
   res.cells = long(mesh.n_cells());
   const auto t0 = Clock::now();
-  AleFlow<2, Pair, BSS, false, Solver> flow(std::move(mesh), FlowOptions{.rho = 1e-12, .mu = mu});
+  AleFlow<FlowConfig<2, Pair, BSS, UnsteadyStokes, Solver>> flow(std::move(mesh), FlowOptions{.rho = 1e-12, .mu = mu});
   for (int t : walls) flow.set_velocity(t, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });
   RigidBody2D body = disk_body(body_tag, c, R, 1e-12);
   body.slip = squirmer_slip(B1, 0, Vec<2>(1, 0));

@@ -31,7 +31,7 @@
 #include <string>
 
 using namespace alefsi;
-using Flow = AleFlow<2, P1P1Gls, BDF2_BDF2E>;
+using Flow = AleFlow<FlowConfig<2, P1P1Gls, BDF2_BDF2E>>;
 
 namespace {
 struct Setup {

@@ -37,9 +37,9 @@ template class ElasticMeshMotion<3>;
 template class AleNavierStokesKernel<2, TaylorHood>;
 template class AleNavierStokesKernel<2, P1P1Gls>;
 template class AleNavierStokesKernel<3, TaylorHood, false>;
-template class AleFlow<2, TaylorHood, BDF3_BDF3E>;
-template class AleFlow<2, P1P1Gls, BDF2_BDF2E>;
-template class AleFlow<3, TaylorHood, MR_AB, false>;
+template class AleFlow<FlowConfig<2, TaylorHood, BDF3_BDF3E>>;
+template class AleFlow<FlowConfig<2, P1P1Gls, BDF2_BDF2E>>;
+template class AleFlow<FlowConfig<3, TaylorHood, MR_AB, UnsteadyStokes>>;
 template class SparseLu<Eigen::AMDOrdering<Index>>;
 }  // namespace alefsi
 

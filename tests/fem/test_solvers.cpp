@@ -405,8 +405,8 @@ TEST_CASE("AleFlow with SaddlePointGmres: a 3D Navier–Stokes step with a free 
     return rep;
   };
   const Mesh<3> mesh = read_gmsh<3>(std::string(ALEFSI_TEST_DATA_DIR) + "/gmsh/sphere_in_box3d.msh").mesh;
-  AleFlow<3, TaylorHood, BDF2_BDF2E, true> direct(mesh, FlowOptions{1.0, 1.0});
-  AleFlow<3, TaylorHood, BDF2_BDF2E, true, SaddlePointGmres<3>> krylov(mesh, FlowOptions{1.0, 1.0});
+  AleFlow<FlowConfig<3, TaylorHood, BDF2_BDF2E>> direct(mesh, FlowOptions{1.0, 1.0});
+  AleFlow<FlowConfig<3, TaylorHood, BDF2_BDF2E, NavierStokes, SaddlePointGmres<3>>> krylov(mesh, FlowOptions{1.0, 1.0});
   run(direct);
   const StepReport rep = run(krylov);
   CHECK(rep.newton_iterations <= 4);  // GMRES to 1e-8 per Newton update, Newton to 1e-10

@@ -74,7 +74,7 @@ template <int D, class Pair, class Scheme>
 Real run_mms(int steps, Real T, bool elastic, int n_mesh = 4, Linearisation lin = Linearisation::newton) {
   using Ex = Exact<D, Pair>;
   FlowOptions opt{rho, mu, lin, 25, 1e-13};
-  AleFlow<D, Pair, Scheme> flow(unit_mesh<D>(n_mesh), opt);
+  AleFlow<FlowConfig<D, Pair, Scheme>> flow(unit_mesh<D>(n_mesh), opt);
   for (int t = 1; t <= 2 * D; ++t) flow.set_velocity(t, Ex::u);
   if (elastic) {
     // the bottom wall's nodes slide along it; the interior follows by elasticity
@@ -119,7 +119,7 @@ TEMPLATE_TEST_CASE("geometric conservation: a uniform flow stays exact on a movi
   const Vec<2> U(1.0, -0.5);
   auto run = [&](auto pair_tag, bool elastic) {
     using Pair = decltype(pair_tag);
-    AleFlow<2, Pair, TestType> flow(rectangle_mesh(5, 5), FlowOptions{rho, mu});
+    AleFlow<FlowConfig<2, Pair, TestType>> flow(rectangle_mesh(5, 5), FlowOptions{rho, mu});
     for (int t = 1; t <= 4; ++t) flow.set_velocity(t, [&](const Vec<2>&, Real) { return U; });
     if (elastic)
       flow.set_mesh_velocity(tags::bottom, [](const Vec<2>& x, Real t) { return Vec<2>(0.4 * std::sin(pi * x[0]) * std::cos(3 * t), 0); });
@@ -165,10 +165,10 @@ TEST_CASE("Newton converges quadratically with the exact Jacobian", "[ale][quick
       CHECK(q > 1.8);
     };
     if (pass == 0) {
-      AleFlow<2, TaylorHood, BDF2_BDF2E> flow(rectangle_mesh(4, 4), FlowOptions{rho, 0.01, Linearisation::newton, 25, 1e-14});
+      AleFlow<FlowConfig<2, TaylorHood, BDF2_BDF2E>> flow(rectangle_mesh(4, 4), FlowOptions{rho, 0.01, Linearisation::newton, 25, 1e-14});
       check(flow);
     } else {
-      AleFlow<2, P1P1Gls, BDF2_BDF2E> flow(rectangle_mesh(6, 6), FlowOptions{rho, 0.01, Linearisation::newton, 25, 1e-14});
+      AleFlow<FlowConfig<2, P1P1Gls, BDF2_BDF2E>> flow(rectangle_mesh(6, 6), FlowOptions{rho, 0.01, Linearisation::newton, 25, 1e-14});
       check(flow);
     }
   }
@@ -232,7 +232,7 @@ Real kov_p(const Vec<2>& x) { return 0.5 * (1 - std::exp(2 * kov_lambda() * x[0]
 template <class Pair>
 std::pair<Real, FlowErrors> kovasznay(int n) {
   // one backward-Euler step with dt -> infinity is Newton's method for the steady problem
-  AleFlow<2, Pair, BSS> flow(rectangle_mesh(n, n * 4 / 3, -0.5, 1.0, -0.5, 1.5),
+  AleFlow<FlowConfig<2, Pair, BSS>> flow(rectangle_mesh(n, n * 4 / 3, -0.5, 1.0, -0.5, 1.5),
                              FlowOptions{1.0, 1.0 / kov_re, Linearisation::newton, 30, 1e-12});
   for (int t = 1; t <= 4; ++t) flow.set_velocity(t, [](const Vec<2>& x, Real) { return kov_u(x); });
   flow.step(1e14);
@@ -263,7 +263,7 @@ TEMPLATE_TEST_CASE("steady Navier-Stokes (Kovasznay, Re = 40): spatial rates", "
 
 TEST_CASE("a step whose Newton iteration fails is rejected and leaves the state at t^n", "[ale][quick]") {
   using Ex = Exact<2, TaylorHood>;
-  AleFlow<2, TaylorHood, BDF2_BDF2E> flow(rectangle_mesh(4, 4), FlowOptions{rho, 0.01, Linearisation::newton, 1, 1e-14});
+  AleFlow<FlowConfig<2, TaylorHood, BDF2_BDF2E>> flow(rectangle_mesh(4, 4), FlowOptions{rho, 0.01, Linearisation::newton, 1, 1e-14});
   for (int t = 1; t <= 4; ++t) flow.set_velocity(t, Ex::u);
   flow.set_prescribed_mesh_velocity(wobble<2>);
   flow.set_force([](const Vec<2>& x, Real t) { return Vec<2>(40 * Ex::f(x, t)); });

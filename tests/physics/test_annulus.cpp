@@ -154,7 +154,7 @@ struct Fig7Case {
   // omega_h at the end of each step
   template <class Scheme>
   std::vector<Real> fem_omega(const Mesh<2>& mesh, Real dt, int steps, VecX* field = nullptr) const {
-    AleFlow<2, TaylorHood, Scheme> flow(mesh, FlowOptions{1.0, 1.0});
+    AleFlow<FlowConfig<2, TaylorHood, Scheme>> flow(mesh, FlowOptions{1.0, 1.0});
     flow.set_velocity(tags::outer, [c = *this](const Vec<2>& x, Real t) { return Vec<2>(c.omega2(t) * Vec<2>(-x[1], x[0])); });
     RigidBody2D body;
     body.tag = tags::inner;
@@ -239,7 +239,7 @@ struct SmoothInSpace {
   template <class Scheme>
   static Real error(int steps, bool elastic, int damped) {
     const Real T = 1;
-    AleFlow<2, TaylorHood, Scheme> flow(rectangle_mesh(4, 4), FlowOptions{rho, mu, Linearisation::newton, 25, 1e-13, damped});
+    AleFlow<FlowConfig<2, TaylorHood, Scheme>> flow(rectangle_mesh(4, 4), FlowOptions{rho, mu, Linearisation::newton, 25, 1e-13, damped});
     for (int t = 1; t <= 4; ++t) flow.set_velocity(t, u);
     if (elastic)
       flow.set_mesh_velocity(tags::bottom, [](const Vec<2>& x, Real t) {
@@ -292,7 +292,7 @@ namespace {
 template <class Scheme>
 Real spun_body(Real dt, int damped, Real T = 0.1) {
   const Real r1 = 0.25, r2 = 1.0;
-  AleFlow<2, TaylorHood, Scheme> flow(annulus_mesh(r1, r2, 3, 32),
+  AleFlow<FlowConfig<2, TaylorHood, Scheme>> flow(annulus_mesh(r1, r2, 3, 32),
                                       FlowOptions{1.0, 1.0, Linearisation::semi_implicit, 25, 1e-10, damped});
   flow.set_velocity(tags::outer, [](const Vec<2>& x, Real) { return Vec<2>(-x[1], x[0]); });
   RigidBody2D body;
@@ -333,7 +333,7 @@ namespace {
 template <class Scheme>
 VecX impulsive_field(const Mesh<2>& mesh, Real dt, int damped, Real T) {
   const Real r1 = 0.25;
-  AleFlow<2, TaylorHood, Scheme> flow(mesh, FlowOptions{1.0, 1.0, Linearisation::semi_implicit, 25, 1e-10, damped});
+  AleFlow<FlowConfig<2, TaylorHood, Scheme>> flow(mesh, FlowOptions{1.0, 1.0, Linearisation::semi_implicit, 25, 1e-10, damped});
   flow.set_velocity(tags::outer, [](const Vec<2>& x, Real) { return Vec<2>(-x[1], x[0]); });
   RigidBody2D body;
   body.tag = tags::inner;
@@ -387,7 +387,7 @@ TEST_CASE("damped start: checkpoint + restart continues bit for bit, across a da
           "[annulus][damped][checkpoint][quick]") {
   // BDF3/BDF3E (extrapolated damped start, then an MR/AB start-up step), free inner cylinder;
   // the dt change after the checkpoint restarts the history, with a damped start again.
-  using Flow = AleFlow<2, TaylorHood, BDF3_BDF3E>;
+  using Flow = AleFlow<FlowConfig<2, TaylorHood, BDF3_BDF3E>>;
   const FlowOptions opt{1.0, 1.0, Linearisation::newton, 25, 1e-10, 4};
   auto configure = [](Flow& flow) {
     flow.set_velocity(tags::outer, [](const Vec<2>& x, Real) { return Vec<2>(-x[1], x[0]); });
@@ -424,12 +424,12 @@ TEST_CASE("damped start: checkpoint + restart continues bit for bit, across a da
 TEST_CASE("damped start: bad substep counts are refused naming the parameter; a failed damped step leaves t^n",
           "[annulus][damped][quick]") {
   for (int m : {-2, 1, 3, 66})
-    CHECK_THROWS_WITH((AleFlow<2, TaylorHood, MR_AB>(annulus_mesh(0.25, 1.0, 2, 16),
+    CHECK_THROWS_WITH((AleFlow<FlowConfig<2, TaylorHood, MR_AB>>(annulus_mesh(0.25, 1.0, 2, 16),
                                                      FlowOptions{1.0, 1.0, Linearisation::newton, 25, 1e-10, m})),
                       Catch::Contains("damped_start"));
   // Newton limited to one iteration cannot converge: the damped first step throws in a substep
   // and must leave the flow exactly at t0 (time, field, body, mesh, no history level taken)
-  AleFlow<2, TaylorHood, BDF3_BDF3E> flow(annulus_mesh(0.25, 1.0, 2, 16),
+  AleFlow<FlowConfig<2, TaylorHood, BDF3_BDF3E>> flow(annulus_mesh(0.25, 1.0, 2, 16),
                                           FlowOptions{1.0, 1.0, Linearisation::newton, 1, 1e-14, 2});
   flow.set_velocity(tags::outer, [](const Vec<2>& x, Real) { return Vec<2>(-x[1], x[0]); });
   RigidBody2D body;

@@ -20,7 +20,7 @@ namespace {
 template <class Scheme>
 Real couette_spin(int nr, int nt, Real T, Real mu) {
   const Real a = 0.5, b = 1.0;
-  AleFlow<2, TaylorHood, Scheme, false> flow(annulus_mesh(a, b, nr, nt), FlowOptions{0.01, mu});
+  AleFlow<FlowConfig<2, TaylorHood, Scheme, UnsteadyStokes>> flow(annulus_mesh(a, b, nr, nt), FlowOptions{0.01, mu});
   flow.set_velocity(tags::outer, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });
   RigidBody2D body;
   body.tag = tags::inner;
@@ -57,7 +57,7 @@ TEST_CASE("a free, neutrally buoyant disk in simple shear turns at -gamma_dot / 
   const Real a = 0.1, L = 1.0, gamma = 1.0;
   Circle disk{Vec<2>(L, L), a, 5};
   auto mesh = channel_with_disks(2 * L, 2 * L, {disk}, 0.02, 0.15);
-  AleFlow<2, TaylorHood, BDF2_BDF2E, false> flow(std::move(mesh), FlowOptions{1.0, 1.0});
+  AleFlow<FlowConfig<2, TaylorHood, BDF2_BDF2E, UnsteadyStokes>> flow(std::move(mesh), FlowOptions{1.0, 1.0});
   for (int t = 1; t <= 4; ++t) flow.set_velocity(t, [&](const Vec<2>& x, Real) { return Vec<2>(gamma * (x[1] - L), 0.0); });
   RigidBody2D body;
   body.tag = 5;
@@ -79,7 +79,7 @@ TEMPLATE_TEST_CASE("extreme density ratios stay stable (annulus, outer wall turn
                    BDF2_BDF2E, BDF2_AB, BDF3_BDF3E, BSS) {
   const Real r1 = 0.25, r2 = 1.0;
   for (Real rho_s : {1e-6, 1e2}) {
-    AleFlow<2, P1P1Gls, TestType> flow(annulus_mesh(r1, r2, 6, 64), FlowOptions{1.0, 1.0});
+    AleFlow<FlowConfig<2, P1P1Gls, TestType>> flow(annulus_mesh(r1, r2, 6, 64), FlowOptions{1.0, 1.0});
     flow.set_velocity(tags::outer, [](const Vec<2>& x, Real) { return Vec<2>(-x[1], x[0]); });  // omega_2 = 1
     RigidBody2D body;
     body.tag = tags::inner;
@@ -108,7 +108,7 @@ TEMPLATE_TEST_CASE("free body spun up by the wall: angular velocity converges at
                    "[bodies][quick]", MR_AB, BDF2_BDF2E, BDF2_AB, BDF3_BDF3E, BSS) {
   const Real r1 = 0.25, r2 = 1.0, T = 0.4;
   auto omega_at_T = [&](Real dt) {
-    AleFlow<2, TaylorHood, TestType> flow(annulus_mesh(r1, r2, 3, 32),
+    AleFlow<FlowConfig<2, TaylorHood, TestType>> flow(annulus_mesh(r1, r2, 3, 32),
                                           FlowOptions{1.0, 1.0, Linearisation::semi_implicit});
     flow.set_velocity(tags::outer, [](const Vec<2>& x, Real t) {
       const Real w2 = 1 - std::exp(-std::pow(t / 0.1, 4));
@@ -133,7 +133,7 @@ TEMPLATE_TEST_CASE("free body spun up by the wall: angular velocity converges at
 }
 
 TEST_CASE("bad bodies are rejected before any step", "[bodies][quick]") {
-  AleFlow<2, TaylorHood, BDF2_BDF2E> flow(annulus_mesh(0.25, 1.0, 2, 16), FlowOptions{1.0, 1.0});
+  AleFlow<FlowConfig<2, TaylorHood, BDF2_BDF2E>> flow(annulus_mesh(0.25, 1.0, 2, 16), FlowOptions{1.0, 1.0});
   RigidBody2D body;
   body.tag = tags::inner;
   body.mass = -1;
@@ -147,7 +147,7 @@ TEST_CASE("bad bodies are rejected before any step", "[bodies][quick]") {
 TEST_CASE("2D squirmer: a disk with slip B1 sin(theta) swims at U = B1 / 2 (Blake)", "[bodies][quick]") {
   const Real a = 0.1, B1 = 1.0, L = 4.0;
   Circle disk{Vec<2>(L / 2, L / 2), a, 5};
-  AleFlow<2, TaylorHood, BDF2_BDF2E, false> flow(channel_with_disks(L, L, {disk}, 0.02, 0.4), FlowOptions{1.0, 1.0});
+  AleFlow<FlowConfig<2, TaylorHood, BDF2_BDF2E, UnsteadyStokes>> flow(channel_with_disks(L, L, {disk}, 0.02, 0.4), FlowOptions{1.0, 1.0});
   for (int t = 1; t <= 4; ++t) flow.set_velocity(t, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });
   RigidBody2D body;
   body.tag = 5;

@@ -143,7 +143,7 @@ struct SpinResult {
   Vec<3> centre;
 };
 SpinResult sphere_couette(const std::string& mesh, Real T, Real mu, int steps, Real dt) {
-  AleFlow<3, TaylorHood, BDF2_BDF2E, false> flow(gmsh_mesh(mesh), FlowOptions{0.01, mu});
+  AleFlow<FlowConfig<3, TaylorHood, BDF2_BDF2E, UnsteadyStokes>> flow(gmsh_mesh(mesh), FlowOptions{0.01, mu});
   flow.set_velocity(2, [](const Vec<3>&, Real) { return Vec<3>(0, 0, 0); });
   RigidBody3D body;
   body.tag = 1;
@@ -186,7 +186,7 @@ TEST_CASE("torque on a sphere turning inside a fixed sphere: 8 pi mu w a^3 b^3 /
 TEST_CASE("a free, neutrally buoyant sphere in simple shear turns at (0, 0, -gamma / 2) and does not drift",
           "[bodies3d][quick]") {
   const Real a = 0.2, gamma = 1.0;
-  AleFlow<3, TaylorHood, BDF2_BDF2E, false> flow(gmsh_mesh("sphere_in_box3d.msh"), FlowOptions{1.0, 1.0});
+  AleFlow<FlowConfig<3, TaylorHood, BDF2_BDF2E, UnsteadyStokes>> flow(gmsh_mesh("sphere_in_box3d.msh"), FlowOptions{1.0, 1.0});
   flow.set_velocity(1, [&](const Vec<3>& x, Real) { return Vec<3>(gamma * x[1], 0.0, 0.0); });
   flow.add_body(sphere_body(5, Vec<3>::Zero(), a, 1.0));
   flow.set_initial_velocity([&](const Vec<3>& x) { return Vec<3>(gamma * x[1], 0.0, 0.0); });
@@ -206,7 +206,7 @@ TEST_CASE("3D body: after many steps the quaternion is unit and the surface node
   // and anisotropic, tilted, so its angular velocity is not along a principal axis
   const Real Omega = 2.0;
   // P1/P1-GLS keeps the 100 steps cheap
-  AleFlow<3, P1P1Gls, BDF2_BDF2E, false> flow(gmsh_mesh("shell3d_h025.msh"), FlowOptions{1.0, 1.0});
+  AleFlow<FlowConfig<3, P1P1Gls, BDF2_BDF2E, UnsteadyStokes>> flow(gmsh_mesh("shell3d_h025.msh"), FlowOptions{1.0, 1.0});
   auto turn = [=](const Vec<3>& x, Real) { return Vec<3>(Vec<3>(0, 0, Omega).cross(x)); };
   flow.set_velocity(2, turn);
   flow.set_mesh_velocity(2, turn);
@@ -239,7 +239,7 @@ TEST_CASE("3D body: after many steps the quaternion is unit and the surface node
 }
 
 TEST_CASE("3D bodies: checkpoint + restart continues bit for bit", "[bodies3d][checkpoint][quick]") {
-  using Flow = AleFlow<3, TaylorHood, BDF2_BDF2E, false>;
+  using Flow = AleFlow<FlowConfig<3, TaylorHood, BDF2_BDF2E, UnsteadyStokes>>;
   auto configure = [](Flow& f) {
     f.set_velocity(2, [](const Vec<3>&, Real) { return Vec<3>(0, 0, 0); });
     RigidBody3D body = anisotropic_body();
@@ -358,7 +358,7 @@ using SquirmerSolver = UmfPackLu;
 #else
 using SquirmerSolver = SparseLu<>;
 #endif
-using SquirmerFlow = AleFlow<3, TaylorHood, BSS, false, SquirmerSolver>;
+using SquirmerFlow = AleFlow<FlowConfig<3, TaylorHood, BSS, UnsteadyStokes, SquirmerSolver>>;
 
 // sigma n integrated over the boundary facets tagged `tag` (n into the fluid: the force of the
 // fluid on the solid there) and its moment about the origin:

@@ -103,7 +103,7 @@ template <class Pair>
 Real uniform_flow_with_remeshing(int steps, int* remeshes) {
   const Real U = 1.0, R = 0.2;
   const Circle c{Vec<2>(0.8, 1.0), R, 5};
-  AleFlow<2, Pair, BDF2_BDF2E> flow(channel_with_disks(3, 2, {c}, 0.06, 0.2), {.rho = 1, .mu = 0.05});
+  AleFlow<FlowConfig<2, Pair, BDF2_BDF2E>> flow(channel_with_disks(3, 2, {c}, 0.06, 0.2), {.rho = 1, .mu = 0.05});
   for (int t = 1; t <= 4; ++t) flow.set_velocity(t, [&](const Vec<2>&, Real) { return Vec<2>(U, 0); });
   RigidBody2D body = disk_body(5, c.centre, R, 1.0);
   body.prescribed = [&](Real) { return Vec<3>(U, 0, 0); };
@@ -134,7 +134,7 @@ TEMPLATE_TEST_CASE("remeshing every step keeps a uniform flow past a moving disk
 }
 
 namespace {
-using Dkt = AleFlow<2, P1P1Gls, BDF2_BDF2E>;
+using Dkt = AleFlow<FlowConfig<2, P1P1Gls, BDF2_BDF2E>>;
 // A coarse two-disk sedimentation (DKT set-up, coarser mesh).
 void configure(Dkt& flow, const std::vector<Circle>& disks) {
   for (int t = 1; t <= 4; ++t) flow.set_velocity(t, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });

@@ -27,7 +27,7 @@ using Solver = SparseLu<>;
 constexpr Real R = 1, B1 = 1;
 
 Vec<3> swim(Mesh<2> mesh, const Vec<2>& centre, const std::vector<int>& walls) {
-  AleFlow<2, TaylorHood, BSS, false, Solver> flow(std::move(mesh), FlowOptions{.rho = 1e-12, .mu = 1});
+  AleFlow<FlowConfig<2, TaylorHood, BSS, UnsteadyStokes, Solver>> flow(std::move(mesh), FlowOptions{.rho = 1e-12, .mu = 1});
   for (int t : walls) flow.set_velocity(t, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });
   RigidBody2D body = disk_body(5, centre, R, 1e-12);
   body.slip = squirmer_slip(B1, 0, Vec<2>(1, 0));

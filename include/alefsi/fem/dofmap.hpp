@@ -13,9 +13,12 @@
 ///     alefsi::MixedSpace<2, alefsi::TaylorHood> space(mesh);
 ///     auto dofs = space.cell_field_dofs(c);        // 15 field indices for a P2/P1 triangle
 ///     Vec<2> x = space.velocity().point(i);        // where scalar velocity DOF i sits
+///     Vec<2> y = space.velocity().point(i, X);     // ... when the mesh nodes are at X
+#include <algorithm>
 #include <array>
 #include <vector>
 
+#include "alefsi/core/error.hpp"
 #include "alefsi/fem/concepts.hpp"
 #include "alefsi/fem/element_pair.hpp"
 #include "alefsi/mesh/mesh.hpp"
@@ -45,6 +48,15 @@ class DofMap {
     const auto& e = mesh_->edge(i - mesh_->n_nodes());
     return 0.5 * (mesh_->node(e[0]) + mesh_->node(e[1]));
   }
+  /// Location of global DOF i when the mesh nodes are at `x` (one position per node, e.g. a
+  /// past or predicted configuration of a moving mesh).
+  Vec<D> point(Index i, const std::vector<Vec<D>>& x) const {
+    if (i < mesh_->n_nodes()) return x[std::size_t(i)];
+    const auto& e = mesh_->edge(i - mesh_->n_nodes());
+    return 0.5 * (x[std::size_t(e[0])] + x[std::size_t(e[1])]);
+  }
+  /// The DOF on mesh node v (vertex DOFs come first, in node order).
+  Index node_dof(Index v) const { return v; }
   /// Global DOFs on boundary facets with the given tag (sorted).
   std::vector<Index> boundary_dofs(int tag) const {
     std::vector<Index> out = mesh_->boundary_nodes(tag);
@@ -79,6 +91,26 @@ class MixedSpace {
   Index n_field() const { return D * velocity_.n_dofs() + pressure_.n_dofs(); }
   Index velocity_field(Index scalar_dof, int component) const { return D * scalar_dof + component; }
   Index pressure_field(Index scalar_dof) const { return D * velocity_.n_dofs() + scalar_dof; }
+
+  /// The velocity part of a field vector: D interleaved components per velocity DOF (component
+  /// c of DOF i at D i + c), as a Lagrange field with D components.
+  std::vector<Real> velocity_values(const VecX& field) const {
+    ALEFSI_CHECK_ARG(field.size() == n_field(), "field", "has ", field.size(), " entries, expected ", n_field());
+    return std::vector<Real>(field.data(), field.data() + D * velocity_.n_dofs());
+  }
+  /// The pressure part of a field vector, one value per pressure DOF.
+  std::vector<Real> pressure_values(const VecX& field) const {
+    ALEFSI_CHECK_ARG(field.size() == n_field(), "field", "has ", field.size(), " entries, expected ", n_field());
+    return std::vector<Real>(field.data() + D * velocity_.n_dofs(), field.data() + field.size());
+  }
+  /// The field vector of a velocity and a pressure part (the inverse of velocity_values and
+  /// pressure_values; the sizes must be those of one space).
+  static VecX join(const std::vector<Real>& velocity, const std::vector<Real>& pressure) {
+    VecX u(Index(velocity.size() + pressure.size()));
+    std::copy(velocity.begin(), velocity.end(), u.data());
+    std::copy(pressure.begin(), pressure.end(), u.data() + velocity.size());
+    return u;
+  }
 
   CellDofs cell_field_dofs(Index c) const {
     CellDofs out;

@@ -2,7 +2,7 @@
 /// \file la/suitesparse.hpp
 /// SuiteSparse solver policies through Eigen's wrappers, compiled in when CMake found
 /// SuiteSparse (option ALEFSI_WITH_SUITESPARSE, compile definition ALEFSI_HAVE_SUITESPARSE on
-/// alefsi::alefsi). Without it this header declares only `DefaultSpdSolver`.
+/// alefsi::alefsi). Without it this header declares only the aliases below.
 ///
 ///   UmfPackLu:  UMFPACK's multifrontal LU. Strategy `symmetric` (the default here: AMD on
 ///               A + A^T, diagonal pivots preferred) suits the symmetric-pattern flow
@@ -12,7 +12,12 @@
 ///               Supernodal, not CHOLMOD's automatic choice: a small matrix would get a
 ///               simplicial LDL^T, which factorises indefinite matrices without complaint.
 ///   DefaultSpdSolver: CholmodLlt when SuiteSparse is there, else SimplicialLlt; the
-///               mesh-velocity problem (physics/mesh_motion.hpp) uses it.
+///               mesh-velocity problem (physics/mesh_motion.hpp) uses it in 3D
+///               (`DefaultSpdSolverFor<D>`: SimplicialLlt in 2D).
+///   DefaultDirectSolver: UmfPackLu when SuiteSparse is there, else SparseLu<> (saddle-point
+///               AMD): the direct solver for flow systems of 1e4-1e6 unknowns where UMFPACK is
+///               the faster (docs/solvers.md). Not FlowConfig's default, which is SparseLu<> in
+///               every build so that a scene's numbers do not depend on what CMake found.
 /// Both use the BLAS that the SuiteSparse libraries load (Debian: libblas.so.3, OpenBLAS when
 /// libopenblas is installed; with OPENBLAS_NUM_THREADS unset it uses every core).
 ///
@@ -134,10 +139,12 @@ static_assert(LinearSolver<UmfPackLu>, "UmfPackLu must model LinearSolver");
 static_assert(LinearSolver<CholmodLlt>, "CholmodLlt must model LinearSolver");
 
 using DefaultSpdSolver = CholmodLlt;
+using DefaultDirectSolver = UmfPackLu;
 
 #else
 
 using DefaultSpdSolver = SimplicialLlt;
+using DefaultDirectSolver = SparseLu<>;
 
 #endif
 

@@ -34,6 +34,7 @@
 #include <functional>
 #include <numbers>
 #include <string>
+#include <tuple>
 
 #include "alefsi/core/error.hpp"
 #include "alefsi/core/types.hpp"
@@ -324,18 +325,50 @@ inline Mat<3> so3_left_jacobian_inverse(const Vec<3>& phi) {
   return Mat<3>::Identity() - 0.5 * P + c * P * P;
 }
 
-/// What differs between 2D and 3D rigid bodies, for sim/ale_flow.hpp: the body type, the number
-/// of rigid DOFs, H, the orientation and its update, the inertia term and its Jacobian.
+/// What differs between 2D and 3D rigid bodies: the rigid-body models of the flow
+/// (sim/body_system.hpp reads a body only through these). A model is a traits type: the body
+/// description `Body`, the number of rigid DOFs, H, the orientation and its update, the inertia
+/// term and its Jacobian, and the accessors of every body property the coupling reads; see the
+/// concept `RigidBodyModel` below.
 template <int D>
 struct RigidBodyTraits;
 
+/// The accessors both built-in models share (a model may define them differently).
+template <class Body, class Velocity>
+struct RigidBodyAccessors {
+  static int tag(const Body& b) { return b.tag; }
+  static bool is_free(const Body& b) { return b.free(); }
+  static void validate(const Body& b, std::size_t index) { b.validate(index); }
+  static auto initial_centre(const Body& b) { return b.centre; }
+  /// Z at t0: the given motion's at t0 for a driven body, else `velocity`.
+  static Velocity initial_velocity(const Body& b, Real t0) { return b.prescribed ? b.prescribed(t0) : b.velocity; }
+  /// Z(t) of a driven body.
+  static Velocity prescribed_velocity(const Body& b, Real t) { return b.prescribed(t); }
+  static bool has_slip(const Body& b) { return bool(b.slip); }
+  /// u_s at the body-frame offset r.
+  template <class V>
+  static V slip(const Body& b, const V& r) {
+    return b.slip(r);
+  }
+  static Real mass(const Body& b) { return b.mass; }
+  /// Constant external force and torque on a free body (besides gravity).
+  static Velocity external_load(const Body& b) { return b.external_load; }
+  /// > 0: a disk / sphere of this radius (exact surface for the remesher, exact contact distances).
+  static Real radius(const Body& b) { return b.radius; }
+};
+
 template <>
-struct RigidBodyTraits<2> {
+struct RigidBodyTraits<2> : RigidBodyAccessors<RigidBody2D, Vec<3>> {
   using Body = RigidBody2D;
   static constexpr int dim = 2;
   static constexpr int n_dof = 3;
   using Velocity = Vec<3>;
   using Orientation = Real;  ///< the angle theta
+  /// Names of the CSV columns of the orientation, the velocity Z and the load (run()).
+  static constexpr std::array<const char*, 1> orientation_columns{"angle"};
+  static constexpr std::array<const char*, 3> velocity_columns{"vx", "vy", "omega"};
+  static constexpr std::array<const char*, 3> load_columns{"fx", "fy", "torque"};
+  static std::array<Real, 1> orientation_values(Orientation th) { return {th}; }
   static Orientation initial_orientation(const Body& b) { return b.angle; }
   /// A surface offset at t0 as stored (world axes at the initial angle).
   static Vec<2> initial_offset(const Vec<2>& r, const Body&) { return r; }
@@ -352,6 +385,8 @@ struct RigidBodyTraits<2> {
     for (int k = 1; k <= l; ++k) ts -= b[k] * th[k - 1];
     return ts / b[0];
   }
+  /// Richardson extrapolation 2 a - b of two approximations a (error e) and b (error ~2 e).
+  static Orientation extrapolate(Orientation a, Orientation b) { return 2 * a - b; }
   /// M dZ / dt with M = diag(m, m, I33); dZ = delta_l Z (BDF combination, a0 Z + history).
   static Velocity inertia(const Body& b, Orientation, const Velocity&, const Velocity& dZ, Real dt) {
     return Vec<3>(b.mass, b.mass, b.inertia).cwiseProduct(dZ) / dt;
@@ -366,12 +401,16 @@ struct RigidBodyTraits<2> {
 };
 
 template <>
-struct RigidBodyTraits<3> {
+struct RigidBodyTraits<3> : RigidBodyAccessors<RigidBody3D, Vec<6>> {
   using Body = RigidBody3D;
   static constexpr int dim = 3;
   static constexpr int n_dof = 6;
   using Velocity = Vec<6>;
   using Orientation = Eigen::Quaternion<Real>;  ///< unit, body frame -> world
+  static constexpr std::array<const char*, 4> orientation_columns{"qw", "qx", "qy", "qz"};
+  static constexpr std::array<const char*, 6> velocity_columns{"vx", "vy", "vz", "wx", "wy", "wz"};
+  static constexpr std::array<const char*, 6> load_columns{"fx", "fy", "fz", "tx", "ty", "tz"};
+  static std::array<Real, 4> orientation_values(const Orientation& q) { return {q.w(), q.x(), q.y(), q.z()}; }
   static Orientation initial_orientation(const Body& b) { return b.orientation; }
   /// A surface offset at t0, stored in the body frame.
   static Vec<3> initial_offset(const Vec<3>& r, const Body& b) { return b.orientation.conjugate() * r; }
@@ -403,6 +442,11 @@ struct RigidBodyTraits<3> {
     }
     return (rotation_quaternion(phi) * q[0]).normalized();
   }
+  /// Richardson extrapolation on the rotation group: a (b^-1 a), since
+  /// a exp(e_a) exp(e_a - e_b) = exp(2 e_a - e_b) to O(e^2).
+  static Orientation extrapolate(const Orientation& a, const Orientation& b) {
+    return Orientation(a * (b.inverse() * a)).normalized();
+  }
   /// (m dV / dt, I_w dw / dt + w x (I_w w)) with I_w = R(q) I_body R(q)^T at orientation q;
   /// dZ = delta_l Z (BDF combination, a0 Z + history), Z = (V, w) the new velocity.
   static Velocity inertia(const Body& b, const Orientation& q, const Velocity& Z, const Velocity& dZ, Real dt) {
@@ -426,13 +470,14 @@ struct RigidBodyTraits<3> {
   }
 };
 
-
-/// A rigid-body model: what sim/ale_flow.hpp reads from `RigidBodyTraits<D>` to couple a body of
-/// dimension D to the flow. `Body` is the run-time description (tag, mass and inertia, initial
-/// state, slip, optional prescribed motion Z(t)); free and prescribed bodies share it because a
-/// scene mixes them (a driven cylinder beside free particles) and the choice costs one branch
-/// per body per step. A minimal model is RigidBodyTraits<2>; a new one (e.g. a body constrained
-/// to a plane in 3D) is a traits type with these members, checked by this concept.
+/// A rigid-body model: everything the flow (sim/body_system.hpp, sim/flow_state.hpp, run())
+/// asks of a body of dimension D, and nothing else. `Body` is the run-time description (tag,
+/// mass and inertia, initial state, slip, optional prescribed motion Z(t)); free and prescribed
+/// bodies share it because a scene mixes them (a driven cylinder beside free particles).
+/// Models: RigidBodyTraits<2> (3 DOF), RigidBodyTraits<3> (6 DOF). A new model (e.g. a body
+/// constrained to a plane in 3D, or one with a shape of its own) is a traits type with these
+/// members, checked by this concept; tests/physics/test_body_system.cpp shows that a type
+/// lacking any one of them is rejected.
 ///
 ///     static_assert(alefsi::RigidBodyModel<alefsi::RigidBodyTraits<3>>);
 template <class T>
@@ -441,9 +486,21 @@ concept RigidBodyModel = requires(const typename T::Body& body, const typename T
                                   const Vec<T::dim>& r, const std::array<Real, 4>& bdf, Real dt, int l, std::size_t index) {
   requires T::dim == 2 || T::dim == 3;
   requires T::n_dof == T::dim * (T::dim + 1) / 2;
-  { body.tag } -> std::convertible_to<int>;
-  { body.free() } -> std::same_as<bool>;
-  body.validate(index);
+  requires std::tuple_size_v<decltype(T::velocity_columns)> == std::size_t(T::n_dof);
+  requires std::tuple_size_v<decltype(T::load_columns)> == std::size_t(T::n_dof);
+  // the body's properties
+  { T::tag(body) } -> std::convertible_to<int>;
+  { T::is_free(body) } -> std::same_as<bool>;
+  T::validate(body, index);
+  { T::initial_centre(body) } -> std::convertible_to<Vec<T::dim>>;
+  { T::initial_velocity(body, dt) } -> std::convertible_to<typename T::Velocity>;
+  { T::prescribed_velocity(body, dt) } -> std::convertible_to<typename T::Velocity>;
+  { T::has_slip(body) } -> std::same_as<bool>;
+  { T::slip(body, r) } -> std::convertible_to<Vec<T::dim>>;
+  { T::mass(body) } -> std::convertible_to<Real>;
+  { T::external_load(body) } -> std::convertible_to<typename T::Velocity>;
+  { T::radius(body) } -> std::convertible_to<Real>;
+  // kinematics
   { T::initial_orientation(body) } -> std::convertible_to<typename T::Orientation>;
   { T::initial_offset(r, body) } -> std::convertible_to<Vec<T::dim>>;
   { T::to_world(r, th, body) } -> std::convertible_to<Vec<T::dim>>;
@@ -452,8 +509,13 @@ concept RigidBodyModel = requires(const typename T::Body& body, const typename T
   { T::velocity(Z, r) } -> std::convertible_to<Vec<T::dim>>;
   { T::step_back(th, Z, dt) } -> std::convertible_to<typename T::Orientation>;
   { T::advance(ths, Z, bdf, l, dt) } -> std::convertible_to<typename T::Orientation>;
+  { T::extrapolate(th, th) } -> std::convertible_to<typename T::Orientation>;
+  // dynamics
   { T::inertia(body, th, Z, Z, dt) } -> std::convertible_to<typename T::Velocity>;
   { T::inertia_jacobian(body, th, Z, dt, dt) } -> std::convertible_to<Eigen::Matrix<Real, T::n_dof, T::n_dof>>;
+  // output
+  { T::orientation_values(th) }
+  -> std::convertible_to<std::array<Real, std::tuple_size_v<decltype(T::orientation_columns)>>>;
 };
 
 static_assert(RigidBodyModel<RigidBodyTraits<2>>, "RigidBodyTraits<2> (3-DOF bodies) must model RigidBodyModel");

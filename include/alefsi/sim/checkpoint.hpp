@@ -24,11 +24,12 @@
 #include "alefsi/core/error.hpp"
 #include "alefsi/core/types.hpp"
 #include "alefsi/mesh/io/vtu.hpp"
+#include "alefsi/mesh/mesh.hpp"
 
 namespace alefsi {
 
 inline constexpr char checkpoint_magic[9] = "ALEFSICK";
-inline constexpr std::uint32_t checkpoint_version = 1;
+inline constexpr std::uint32_t checkpoint_version = 2;  // 2: the step-size history replaces the last dt
 
 class CheckpointWriter {
  public:
@@ -139,5 +140,41 @@ class CheckpointReader {
   std::vector<char> data_;
   std::size_t pos_ = 0;
 };
+
+/// Writes section "mesh": node coordinates, cells, cell tags, tagged boundary facets.
+template <int D>
+void write_mesh(CheckpointWriter& w, const Mesh<D>& m) {
+  w.section("mesh");
+  std::vector<Real> x(D * std::size_t(m.n_nodes()));
+  for (Index i = 0; i < m.n_nodes(); ++i)
+    for (int c = 0; c < D; ++c) x[D * std::size_t(i) + c] = m.node(i)[c];
+  w.put_vector(x);
+  w.put_vector(m.cells());
+  w.put_vector(m.cell_tags());
+  std::vector<typename Mesh<D>::Facet> facets;
+  std::vector<int> tags;
+  for (Index f : m.boundary_facets()) facets.push_back(m.facet(f)), tags.push_back(m.facet_tag(f));
+  w.put_vector(facets);
+  w.put_vector(tags);
+}
+
+/// Reads what write_mesh wrote; an invalid mesh is an IoError naming the file.
+template <int D>
+Mesh<D> read_mesh(CheckpointReader& r) {
+  r.section("mesh");
+  const auto x = r.get_vector<Real>("node coordinates");
+  std::vector<Vec<D>> nodes(x.size() / D);
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    for (int c = 0; c < D; ++c) nodes[i][c] = x[D * i + c];
+  auto cells = r.get_vector<typename Mesh<D>::Cell>("cells");
+  auto cell_tags = r.get_vector<int>("cell tags");
+  const auto facets = r.get_vector<typename Mesh<D>::Facet>("boundary facets");
+  const auto tags = r.get_vector<int>("boundary tags");
+  try {
+    return Mesh<D>(std::move(nodes), std::move(cells), facets, tags, std::move(cell_tags));
+  } catch (const MeshError& e) {
+    r.fail(std::string("invalid mesh: ") + e.what());
+  }
+}
 
 }  // namespace alefsi

@@ -1,6 +1,6 @@
 #pragma once
 /// \file sim/driver.hpp
-/// The time loop a user wants around an `AleFlow` (2D bodies): progress lines, VTU/PVD
+/// The time loop a user wants around an `AleFlow` (2D or 3D): progress lines, VTU/PVD
 /// output, a CSV time series of every body, atomic checkpoints, and rejection of failed
 /// steps with a smaller dt.
 ///
@@ -13,8 +13,11 @@
 ///    naming t, dt and the last failure; what was written until then stays valid.
 ///  * the last step is shortened to land on t_end exactly (within 1e-12 dt).
 ///  * output (when `output` is set): `<output>/bodies.csv` (one row per step: t, dt, Newton
-///    iterations, remeshed, worst quality, then per body k: x, y, angle, V1, V2, w,
-///    hydrodynamic force and torque, collision force, gap), `<output>/flow.pvd` + steps every
+///    iterations, remeshed, worst quality, then per body k: the centre (x, y[, z]), the
+///    orientation (2D: angle; 3D: quaternion qw, qx, qy, qz), the velocity Z (2D: vx, vy,
+///    omega; 3D: vx, vy, vz, wx, wy, wz), the hydrodynamic load (2D: fx, fy, torque; 3D: fx,
+///    fy, fz, tx, ty, tz), the contact force (fcx, fcy[, fcz]) and the gap; the column names
+///    are the rigid-body model's), `<output>/flow.pvd` + steps every
 ///    `vtu_every` steps (velocity, pressure, mesh velocity on the P1 nodes),
 ///    `<output>/checkpoint.bin` every `checkpoint_every` steps (atomic; see
 ///    AleFlow::save_checkpoint). A restarted run (flow.time() > 0) appends to bodies.csv after
@@ -76,7 +79,8 @@ struct RunSummary {
 
 namespace detail {
 
-/// P1 nodal values of the flow's velocity (D components) and pressure, for VTU output.
+/// P1 nodal values of the flow's velocity (D components) and pressure, and the mesh velocity,
+/// for VTU output.
 template <class Flow>
 void nodal_fields(const Flow& flow, std::vector<Real>& u, std::vector<Real>& p, std::vector<Real>& w) {
   constexpr int D = Flow::Space::dim;
@@ -86,11 +90,41 @@ void nodal_fields(const Flow& flow, std::vector<Real>& u, std::vector<Real>& p, 
   p.assign(std::size_t(nn), 0);
   w.assign(std::size_t(D) * nn, 0);
   for (Index v = 0; v < nn; ++v) {
-    for (int c = 0; c < D; ++c) u[D * v + c] = flow.field()[sp.velocity_field(v, c)];  // vertex DOFs come first
-    p[v] = flow.field()[sp.pressure_field(v)];
+    const Index iv = sp.velocity().node_dof(v), ip = sp.pressure().node_dof(v);
+    for (int c = 0; c < D; ++c) u[D * v + c] = flow.field()[sp.velocity_field(iv, c)];
+    p[v] = flow.field()[sp.pressure_field(ip)];
     if (!flow.mesh_velocity().empty())
       for (int c = 0; c < D; ++c) w[D * v + c] = flow.mesh_velocity()[v][c];
   }
+}
+
+/// The CSV header of body k's columns (the rigid-body model's names).
+template <class Model>
+void body_csv_header(std::ostream& out, std::size_t k) {
+  constexpr int D = Model::dim;
+  const char* xyz[] = {"x", "y", "z"};
+  for (int c = 0; c < D; ++c) out << ',' << xyz[c] << k;
+  for (const char* n : Model::orientation_columns) out << ',' << n << k;
+  for (const char* n : Model::velocity_columns) out << ',' << n << k;
+  for (const char* n : Model::load_columns) out << ',' << n << k;
+  for (int c = 0; c < D; ++c) out << ",fc" << xyz[c] << k;
+  out << ",gap" << k;
+}
+
+/// Body k's columns at the flow's time.
+template <class Flow>
+void body_csv_row(std::ostream& out, const Flow& flow, std::size_t k, Real gap) {
+  using Model = typename Flow::BodyModel;
+  const auto x = flow.body_centre(k);
+  const auto z = flow.body_velocity(k);
+  const auto f = flow.body_hydrodynamic_load(k);
+  const auto fc = flow.body_collision_force(k);
+  for (int c = 0; c < x.size(); ++c) out << ',' << x[c];
+  for (Real v : Model::orientation_values(flow.body_orientation(k))) out << ',' << v;
+  for (int c = 0; c < z.size(); ++c) out << ',' << z[c];
+  for (int c = 0; c < f.size(); ++c) out << ',' << f[c];
+  for (int c = 0; c < fc.size(); ++c) out << ',' << fc[c];
+  out << ',' << gap;
 }
 
 /// Keeps the header and the rows of a CSV whose first column is <= t.
@@ -133,9 +167,7 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
     csv << std::setprecision(17);
     if (!restart) {
       csv << "t,dt,newton,remeshed,worst_quality";
-      for (std::size_t k = 0; k < nb; ++k)
-        for (const char* n : {"x", "y", "angle", "vx", "vy", "omega", "fx", "fy", "torque", "fcx", "fcy", "gap"})
-          csv << ',' << n << k;
+      for (std::size_t k = 0; k < nb; ++k) detail::body_csv_header<typename Flow::BodyModel>(csv, k);
       csv << '\n';
     }
     if (opt.vtu_every > 0) {
@@ -147,7 +179,8 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
   std::vector<Real> u, p, w;
   auto write_vtu_now = [&] {
     detail::nodal_fields(flow, u, p, w);
-    pvd->write(flow.time(), flow.mesh(), std::vector<VtuField>{{"velocity", 2, u}, {"pressure", 1, p}, {"mesh_velocity", 2, w}});
+    constexpr int D = Flow::Space::dim;
+    pvd->write(flow.time(), flow.mesh(), std::vector<VtuField>{{"velocity", D, u}, {"pressure", 1, p}, {"mesh_velocity", D, w}});
   };
   if (pvd && t_start == 0) write_vtu_now();
 
@@ -193,14 +226,7 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
     sum.min_gap = std::min(sum.min_gap, gap_min);
     if (csv.is_open()) {
       csv << flow.time() << ',' << h_try << ',' << rep.newton_iterations << ',' << int(rep.remeshed) << ',' << q;
-      for (std::size_t k = 0; k < nb; ++k) {
-        const auto x = flow.body_centre(k);
-        const auto z = flow.body_velocity(k);
-        const auto f = flow.body_hydrodynamic_load(k);
-        const auto fc = flow.body_collision_force(k);
-        csv << ',' << x[0] << ',' << x[1] << ',' << flow.body_angle(k) << ',' << z[0] << ',' << z[1] << ',' << z[2] << ','
-            << f[0] << ',' << f[1] << ',' << f[2] << ',' << fc[0] << ',' << fc[1] << ',' << gaps[k];
-      }
+      for (std::size_t k = 0; k < nb; ++k) detail::body_csv_row(csv, flow, k, gaps[k]);
       csv << '\n' << std::flush;
     }
     const int n = flow.stats().steps;

@@ -26,7 +26,12 @@
 ///     static_assert(alefsi::TimeScheme<S> && S::order == 3);
 #include <array>
 #include <concepts>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <type_traits>
 
+#include "alefsi/core/error.hpp"
 #include "alefsi/core/types.hpp"
 
 namespace alefsi {
@@ -134,6 +139,56 @@ constexpr int history_levels() {
 static_assert(TimeScheme<MR_AB> && TimeScheme<BDF2_BDF2E> && TimeScheme<BDF2_AB> && TimeScheme<BDF3_BDF3E> &&
                   TimeScheme<BSS>,
               "the five schemes of the paper must model TimeScheme");
+
+/// A compile-time list of schemes.
+template <TimeScheme... S>
+struct SchemeList {
+  static constexpr std::size_t size = sizeof...(S);
+};
+/// The paper's five schemes, in the paper's order (BSS last).
+using PaperSchemes = SchemeList<MR_AB, BDF2_BDF2E, BDF2_AB, BDF3_BDF3E, BSS>;
+
+/// The display names of the schemes of `List`, comma-separated.
+template <class List = PaperSchemes>
+std::string scheme_names() {
+  return []<TimeScheme... S>(SchemeList<S...>) {
+    std::string out;
+    ((out += (out.empty() ? "" : ", ") + std::string(S::name)), ...);
+    return out;
+  }(List{});
+}
+
+namespace detail {
+/// "BDF2/BDF2E" and "BDF2_BDF2E" name the same scheme (display name, C++ identifier).
+inline bool scheme_name_matches(std::string_view display, std::string_view key) {
+  if (key.size() != display.size()) return false;
+  for (std::size_t i = 0; i < key.size(); ++i)
+    if (key[i] != display[i] && !(display[i] == '/' && key[i] == '_')) return false;
+  return true;
+}
+}  // namespace detail
+
+/// Calls `f.template operator()<S>()` for the scheme S of `List` named `name` (its display name,
+/// e.g. "BDF2/BDF2E", or its type name, "BDF2_BDF2E"), and returns what f returns. An unknown
+/// name throws InvalidArgument naming `parameter` and listing the valid names. This is the one
+/// place where a run-time name becomes a compile-time scheme.
+///
+///     dispatch_scheme(options.get<std::string>("scheme"), [&]<class S>() { run<S>(); });
+template <class List = PaperSchemes, class F>
+decltype(auto) dispatch_scheme(std::string_view name, F&& f, std::string_view parameter = "scheme") {
+  return [&]<TimeScheme... S>(SchemeList<S...>) -> decltype(auto) {
+    using R = decltype(f.template operator()<MR_AB>());
+    if constexpr (std::is_void_v<R>) {
+      const bool found = ((detail::scheme_name_matches(S::name, name) ? (f.template operator()<S>(), true) : false) || ...);
+      if (!found) throw InvalidArgument(std::string(parameter), "unknown scheme '" + std::string(name) + "'; one of " + scheme_names<List>());
+    } else {
+      std::optional<R> out;
+      ((detail::scheme_name_matches(S::name, name) && (out.emplace(f.template operator()<S>()), true)) || ...);
+      if (!out) throw InvalidArgument(std::string(parameter), "unknown scheme '" + std::string(name) + "'; one of " + scheme_names<List>());
+      return R(std::move(*out));
+    }
+  }(List{});
+}
 static_assert(history_levels<BSS>() == 0 && history_levels<MR_AB>() == 1 && history_levels<BDF3_BDF3E>() == 2);
 
 }  // namespace alefsi

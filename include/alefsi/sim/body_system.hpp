@@ -1,0 +1,451 @@
+#pragma once
+/// \file sim/body_system.hpp
+/// The rigid bodies of a flow and their coupling to it (section 3 of the paper), through a
+/// rigid-body model M (physics/rigid_body.hpp, concept RigidBodyModel): the flow reads a body
+/// only through M, so a new model changes nothing here.
+///
+/// What it does, per body k, with Z^k its rigid velocity ((V1, V2, w) in 2D, (V, w) in 3D):
+///   - topology (after each mesh rebuild): the surface nodes (facets tagged with the body's
+///     tag), the surface velocity DOFs, and for a free body `n_dof` extra unknowns and the
+///     links u = H(x) Z + u_s of its surface DOFs (`attach`, `constrain`);
+///   - the step's prediction: the extrapolated state that drives the mesh-velocity problem
+///     (`mesh_velocity_data`: the rigid velocity of each surface node), the centre and
+///     orientation at t^{n+1} by the scheme's position formula, and the surface nodes at
+///     t^{n+1} by the exact rigid map (`advance`);
+///   - the flow system: the surface velocities at t^{n+1} (Dirichlet data of a driven body,
+///     link weights and offsets of a free one: at X^{n+theta} for its test functions, see
+///     `set_surface_velocities`), the body rows M delta_l Z / dt (+ w x I_w w) - M g - F_ext
+///     - F_contact and their exact Jacobian (`add_rows`), and after the solve Z^{n+1} and the
+///     hydrodynamic load (`finish`);
+///   - views for the contact model and the remesher, and the reset of the surface after a
+///     remesh (`reset_surface`, `reset_surface_velocities`).
+/// The histories (centre, orientation, Z per level, loads, surface offsets) live in the flow
+/// state (sim/flow_state.hpp); this class holds the bodies' descriptions, their topology and
+/// the step's prediction.
+///
+///     BodySystem<2, RigidBodyTraits<2>> bodies;
+///     bodies.add(disk_body(5, {1, 4.5}, 0.125, 1.5), mesh, t0, state.bodies);
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "alefsi/core/eigen_sparse.hpp"
+#include "alefsi/core/error.hpp"
+#include "alefsi/fem/constraints.hpp"
+#include "alefsi/la/assembler.hpp"
+#include "alefsi/mesh/mesh.hpp"
+#include "alefsi/physics/collision.hpp"
+#include "alefsi/physics/rigid_body.hpp"
+#include "alefsi/sim/contact.hpp"
+#include "alefsi/sim/flow_state.hpp"
+#include "alefsi/sim/mesh_velocity.hpp"
+#include "alefsi/sim/remesher.hpp"
+#include "alefsi/time/stepper.hpp"
+
+namespace alefsi {
+
+namespace detail {
+/// The point of a boundary facet (2D: segment, 3D: triangle) closest to p.
+inline Vec<2> closest_on_facet(const Vec<2>& p, const std::array<Vec<2>, 2>& s) { return closest_on_segment(p, s); }
+inline Vec<3> closest_on_facet(const Vec<3>& p, const std::array<Vec<3>, 3>& t) {
+  // Ericson, Real-Time Collision Detection, 5.1.5: Voronoi regions of the triangle
+  const Vec<3> &a = t[0], &b = t[1], &c = t[2];
+  const Vec<3> ab = b - a, ac = c - a, ap = p - a;
+  const Real d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec<3> bp = p - b;
+  const Real d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const Real vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
+  const Vec<3> cp = p - c;
+  const Real d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const Real vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
+  const Real va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
+  const Real den = 1 / (va + vb + vc);
+  return a + ab * (vb * den) + ac * (vc * den);
+}
+}  // namespace detail
+
+template <int D, RigidBodyModel M>
+class BodySystem {
+  static_assert(M::dim == D, "the rigid-body model's dimension must be the flow's");
+
+ public:
+  using Model = M;
+  using Body = typename M::Body;
+  using Velocity = typename M::Velocity;
+  using Orientation = typename M::Orientation;
+  using State = BodyState<D, M>;
+  static constexpr int n_dof = M::n_dof;
+
+  // ---- registry -------------------------------------------------------------------------
+
+  /// Registers `body` (validated, its surface = the boundary facets of `mesh` tagged with its
+  /// tag) and appends its initial state at time t to `states`; returns its index.
+  std::size_t add(const Body& body, const Mesh<D>& mesh, Real t, std::vector<State>& states) {
+    const std::size_t k = entries_.size();
+    M::validate(body, k);
+    const int tag = M::tag(body);
+    ALEFSI_CHECK_ARG(!mesh.boundary_nodes(tag).empty(), "body.tag", "no boundary facet has tag ", tag);
+    for (const auto& e : entries_)
+      ALEFSI_CHECK_ARG(M::tag(e.data) != tag, "body.tag", "bodies[", k, "] has the tag ", tag, " of an earlier body");
+    Entry e;
+    e.data = body;
+    e.nodes = mesh.boundary_nodes(tag);
+    State s;
+    s.centre.fill(M::initial_centre(body));
+    s.orientation.fill(M::initial_orientation(body));
+    s.velocity.fill(M::initial_velocity(body, t));
+    for (Index v : e.nodes) s.surface.push_back(M::initial_offset(mesh.node(v) - M::initial_centre(body), body));
+    entries_.push_back(std::move(e));
+    states.push_back(std::move(s));
+    return k;
+  }
+  std::size_t size() const { return entries_.size(); }
+  bool empty() const { return entries_.empty(); }
+  const Body& body(std::size_t k) const { return entries_.at(k).data; }
+  std::vector<int> tags() const {
+    std::vector<int> t;
+    for (const auto& e : entries_) t.push_back(M::tag(e.data));
+    return t;
+  }
+  bool has_tag(int tag) const {
+    for (const auto& e : entries_)
+      if (M::tag(e.data) == tag) return true;
+    return false;
+  }
+  /// Surface mesh nodes of body k (sorted).
+  const std::vector<Index>& surface_nodes(std::size_t k) const { return entries_.at(k).nodes; }
+
+  // ---- topology ---------------------------------------------------------------------------
+
+  /// Surface nodes and facets on a (new) mesh topology.
+  void attach(const Mesh<D>& mesh) {
+    for (auto& e : entries_) {
+      e.nodes = mesh.boundary_nodes(M::tag(e.data));
+      e.facets.clear();
+      for (Index f : mesh.boundary_facets())
+        if (mesh.facet_tag(f) == M::tag(e.data)) e.facets.push_back(mesh.facet(f));
+    }
+  }
+
+  /// The constraint structure of the surface velocity DOFs: fixed (driven bodies) or linked to
+  /// n_dof new extra unknowns (free bodies). `taken` marks velocity DOFs already constrained
+  /// (Dirichlet walls); a body surface touching one, or another body, is refused.
+  template <class Space>
+  void constrain(const Space& space, DofConstraints& cons, std::vector<char>& taken) {
+    for (auto& e : entries_) {
+      e.dofs.clear();
+      const bool free = M::is_free(e.data);
+      if (free) e.extra = cons.add_unknowns(n_dof);
+      for (Index i : space.velocity().boundary_dofs(M::tag(e.data))) {
+        ALEFSI_CHECK_ARG(!taken[i], "body.tag", "body surface (tag ", M::tag(e.data),
+                         ") touches a Dirichlet wall or another body");
+        taken[i] = 1;
+        e.dofs.push_back(i);
+        for (int k = 0; k < D; ++k) {
+          const Index f = space.velocity_field(i, k);
+          if (free) {
+            std::array<Index, n_dof> ex;
+            for (int C = 0; C < n_dof; ++C) ex[C] = e.extra + C;
+            const std::array<Real, n_dof> w{};
+            cons.link(f, ex, w, 0.0);
+          } else {
+            cons.fix(f, 0.0);
+          }
+        }
+      }
+    }
+  }
+
+  /// Disks and spheres (M::radius > 0): every surface node at the radius from the centre.
+  void check_radii(const Mesh<D>& mesh, const std::vector<State>& states) const {
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      const auto& e = entries_[k];
+      const Real radius = M::radius(e.data);
+      if (radius <= 0) continue;
+      for (Index v : e.nodes)
+        ALEFSI_CHECK_ARG(std::abs((mesh.node(v) - states[k].centre[0]).norm() - radius) <= 1e-6 * radius,
+                         "body.radius", "body with tag ", M::tag(e.data), ": surface node ", v, " is at distance ",
+                         (mesh.node(v) - states[k].centre[0]).norm(), " from the centre, not the radius ", radius);
+    }
+  }
+
+  // ---- one step ---------------------------------------------------------------------------
+
+  /// The rigid velocities of the surface nodes on geometry x for the mesh-velocity problem,
+  /// from the bodies' state extrapolated with weights w (levels n, n-1, n-2), or the driven
+  /// bodies' motion at t. Records the extrapolated velocity as the step's prediction.
+  void mesh_velocity_data(const std::vector<State>& states, const std::vector<Vec<D>>& x, const std::array<Real, 3>& w,
+                          Real t, NodeVelocities<D>& out) {
+    if (entries_.empty()) return;
+    out.value.assign(x.size(), Vec<D>::Zero());
+    out.given.assign(x.size(), 0);
+    for (std::size_t b = 0; b < entries_.size(); ++b) {
+      auto& e = entries_[b];
+      const State& s = states[b];
+      Vec<D> xg = Vec<D>::Zero();
+      Velocity Z = Velocity::Zero();
+      for (int k = 0; k < 3; ++k) xg += w[k] * s.centre[k], Z += w[k] * s.velocity[k];
+      if (!M::is_free(e.data)) Z = M::prescribed_velocity(e.data, t);
+      e.Zhat = Z;
+      for (Index v : e.nodes) {
+        out.value[v] = M::velocity(Z, x[v] - xg);
+        out.given[v] = 1;
+      }
+    }
+  }
+
+  /// The first step after a (re)start of a scheme reading level n-1: x^{n-1} = x^n - dt V^n,
+  /// the orientation stepped back, Z^{n-1} = Z^n.
+  void backfill(std::vector<State>& states, Real dt) const {
+    for (auto& s : states) {
+      s.centre[1] = s.centre[0] - dt * s.velocity[0].template head<D>();
+      s.orientation[1] = M::step_back(s.orientation[0], s.velocity[0], dt);
+      s.velocity[1] = s.velocity[0];
+    }
+  }
+
+  /// Centre and orientation at t^{n+1} by the scheme's position formula with the predicted
+  /// velocity; the surface nodes of `Xn1` by the exact rigid map.
+  void advance(const std::vector<State>& states, const StepCoefficients& c, std::vector<Vec<D>>& Xn1) {
+    const auto& b = c.position_bdf;
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      auto& e = entries_[k];
+      const State& s = states[k];
+      Vec<D> xs = c.dt * e.Zhat.template head<D>();
+      for (int l = 1; l <= c.position_order; ++l) xs -= b[l] * s.centre[l - 1];
+      e.xg_next = xs / b[0];
+      e.th_next = M::advance(s.orientation.at, e.Zhat, b, c.position_order, c.dt);
+      for (std::size_t j = 0; j < e.nodes.size(); ++j)
+        Xn1[e.nodes[j]] = e.xg_next + M::to_world(s.surface[j], e.th_next, e.data);
+    }
+  }
+
+  /// The surface velocities at t^{n+1} = t1, u = H(r^{n+1}) Z + u_s on X^{n+1}: Dirichlet values
+  /// of a driven body; a free body's link. A free body's link is also its rows' test function,
+  /// which must live where the flow is integrated, X^{n+theta} (else the torque row is off by
+  /// (r^{n+1} - r^{n+theta}) x F = O(dt) when theta < 1: the sum of r . F over the surface
+  /// carries the pressure level). So the link takes H(r^{n+theta}) and the offset the rest,
+  /// (H(r^{n+1}) - H(r^{n+theta})) Z*, Z* extrapolated to t^{n+1}: the velocity is off by
+  /// O(dt^3) only. For theta = 1 both are H(r^{n+1}). `Xn` is X^n.
+  template <class Space>
+  void set_surface_velocities(const Space& space, DofConstraints& cons, const std::vector<State>& states,
+                              const StepCoefficients& c, const std::vector<Vec<D>>& Xn1, const std::vector<Vec<D>>& Xth,
+                              Real t1) const {
+    const auto& vel = space.velocity();
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      const auto& e = entries_[k];
+      const State& s = states[k];
+      const bool free = M::is_free(e.data);
+      const Velocity Zp = free ? Velocity::Zero() : Velocity(M::prescribed_velocity(e.data, t1));
+      const Vec<D> xg_th = c.theta * e.xg_next + (1 - c.theta) * s.centre[0];
+      Velocity Zx = c.body_velocity[0] * s.velocity[0] + c.body_velocity[1] * s.velocity[1];
+      if (c.body_velocity[2] != 0) Zx += c.body_velocity[2] * s.velocity[2];
+      for (Index i : e.dofs) {
+        const Vec<D> r = vel.point(i, Xn1) - e.xg_next;
+        Vec<D> us = M::has_slip(e.data)
+                        ? M::to_world(M::slip(e.data, M::to_body(r, e.th_next, e.data)), e.th_next, e.data)
+                        : Vec<D>::Zero();
+        const auto H = M::rows(r);
+        if (!free) {
+          for (int d = 0; d < D; ++d) cons.set_fixed_value(space.velocity_field(i, d), H[d].dot(Zp) + us[d]);
+          continue;
+        }
+        if (c.theta < 1) {
+          const auto Hth = M::rows(Vec<D>(vel.point(i, Xth) - xg_th));
+          for (int d = 0; d < D; ++d) {
+            us[d] += (H[d] - Hth[d]).dot(Zx);
+            cons.set_link(space.velocity_field(i, d), {Hth[d].data(), std::size_t(n_dof)}, us[d]);
+          }
+        } else {
+          for (int d = 0; d < D; ++d) cons.set_link(space.velocity_field(i, d), {H[d].data(), std::size_t(n_dof)}, us[d]);
+        }
+      }
+    }
+  }
+
+  /// The free bodies' unknowns in `u` set to Z^n (Newton's initial guess).
+  void initial_guess(const DofConstraints& cons, const std::vector<State>& states, VecX& u) const {
+    for (std::size_t k = 0; k < entries_.size(); ++k)
+      if (M::is_free(entries_[k].data))
+        u.template segment<n_dof>(cons.extra_unknown(entries_[k].extra)) = states[k].velocity[0];
+  }
+
+  /// The body rows of the free bodies (eq. 11) added to r: M delta_l Z / dt (+ w x I_w w in
+  /// 3D) - M g - external load - contact force, and their Jacobian (exact, gyroscopic term
+  /// included) on each body's diagonal block of J. The contact forces come from `contact` at
+  /// the bodies' velocities at t^{n+1} = t1 (the unknowns of free bodies, the given motion of
+  /// driven ones); each body's total is recorded in its state.
+  void add_rows(std::vector<State>& states, const StepCoefficients& c, const DofConstraints& cons, const VecX& u, VecX& r,
+                SparseMatrix& J, const Vec<D>& gravity, const ContactModel<D>& contact, Real t1) const {
+    const Real a0 = c.flow_bdf[0];
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      const auto& e = entries_[k];
+      State& s = states[k];
+      s.contact = Vec<D>::Zero();
+      if (!M::is_free(e.data)) continue;
+      const Index row = cons.extra_unknown(e.extra);
+      const Velocity Z = u.template segment<n_dof>(row);
+      r.template segment<n_dof>(row) += inertia(e, s, c, Z) - weight(e, gravity) - M::external_load(e.data);
+      const auto Jb = M::inertia_jacobian(e.data, e.th_next, Z, a0, c.dt);
+      for (int i = 0; i < n_dof; ++i)
+        for (int j = 0; j < n_dof; ++j)
+          if (Jb(i, j) != 0) J.coeffRef(row + i, row + j) += Jb(i, j);  // structural zeros stay untouched
+    }
+    std::vector<Vec<D>> v(entries_.size());
+    for (std::size_t k = 0; k < entries_.size(); ++k)
+      v[k] = M::is_free(entries_[k].data)
+                 ? Vec<D>(u.template segment<D>(cons.extra_unknown(entries_[k].extra)))
+                 : Vec<D>(M::prescribed_velocity(entries_[k].data, t1).template head<D>());
+    contact.forces(v, [&](int b, const Vec<D>& F, const Mat<D>& dF) {
+      states[b].contact += F;
+      if (!M::is_free(entries_[b].data)) return;
+      const Index row = cons.extra_unknown(entries_[b].extra);
+      r.template segment<D>(row) -= F;
+      for (int i = 0; i < D; ++i)
+        for (int j = 0; j < D; ++j) J.coeffRef(row + i, row + j) -= dF(i, j);
+    });
+  }
+
+  /// After the solve (`u` the unknowns at t^{n+1} = t1): Z^{n+1} of every body, the hydrodynamic
+  /// load of the free ones from their momentum balance (M delta_l Z / dt (+ w x I_w w) - M g -
+  /// external load - contact force), and the new level of each body's history.
+  void finish(std::vector<State>& states, const StepCoefficients& c, const DofConstraints& cons, const VecX& u, Real t1,
+              const Vec<D>& gravity) const {
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      const auto& e = entries_[k];
+      State& s = states[k];
+      const bool free = M::is_free(e.data);
+      const Velocity Zn1 = free ? Velocity(u.template segment<n_dof>(cons.extra_unknown(e.extra)))
+                                : Velocity(M::prescribed_velocity(e.data, t1));
+      if (free) {
+        s.load = inertia(e, s, c, Zn1) - weight(e, gravity) - M::external_load(e.data);
+        s.load.template head<D>() -= s.contact;
+      }
+      s.velocity.push(Zn1);
+      s.centre.push(e.xg_next);
+      s.orientation.push(e.th_next);
+    }
+  }
+
+  // ---- views and resets -------------------------------------------------------------------
+
+  /// The bodies for a contact model at history level `level` (0: t^n), or at t^{n+1}
+  /// (level = -1: the positions and velocities predicted for the step being solved).
+  std::vector<ContactBody<D>> contact_bodies(const std::vector<State>& states, int level) const {
+    std::vector<ContactBody<D>> out;
+    out.reserve(entries_.size());
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      const auto& e = entries_[k];
+      const State& s = states[k];
+      ContactBody<D> c;
+      c.centre = level < 0 ? e.xg_next : s.centre[level];
+      c.velocity = (level < 0 ? e.Zhat : s.velocity[level]).template head<D>();
+      c.radius = M::radius(e.data);
+      const Orientation& th = level < 0 ? e.th_next : s.orientation[level];
+      auto at = [&](Index v) {
+        const auto it = std::lower_bound(e.nodes.begin(), e.nodes.end(), v);
+        return Vec<D>(c.centre + M::to_world(s.surface[std::size_t(it - e.nodes.begin())], th, e.data));
+      };
+      c.r_in = std::numeric_limits<Real>::infinity();
+      for (const auto& r0 : s.surface) c.r_out = std::max(c.r_out, r0.norm());
+      for (const auto& f : e.facets) {
+        std::array<Vec<D>, D> x;
+        for (int i = 0; i < D; ++i) x[i] = at(f[i]);
+        c.r_in = std::min(c.r_in, (detail::closest_on_facet(c.centre, x) - c.centre).norm());
+        if (c.radius == 0) c.surface.push_back(x);
+      }
+      if (c.radius > 0) c.r_in = c.r_out = c.radius;
+      out.push_back(std::move(c));
+    }
+    return out;
+  }
+
+  /// The bodies for a remesher, at t^n.
+  std::vector<RemeshBody<D>> remesh_bodies(const std::vector<State>& states) const {
+    std::vector<RemeshBody<D>> out;
+    for (std::size_t k = 0; k < entries_.size(); ++k)
+      out.push_back({M::tag(entries_[k].data), states[k].centre[0], M::radius(entries_[k].data)});
+    return out;
+  }
+
+  /// Surface nodes of body k in X (the positions of level `level`) from the exact rigid map.
+  void place_surface(const State& s, std::size_t k, int level, std::vector<Vec<D>>& X) const {
+    const auto& e = entries_[k];
+    for (std::size_t j = 0; j < e.nodes.size(); ++j)
+      X[e.nodes[j]] = s.centre[level] + M::to_world(s.surface[j], s.orientation[level], e.data);
+  }
+
+  /// After a remesh (`attach` done on `mesh`, the levels of `X` transferred): each body's
+  /// surface offsets from the new mesh's nodes (at t^n), and its surface nodes at the past
+  /// levels from its exact rigid motion.
+  void reset_surface(const Mesh<D>& mesh, std::vector<State>& states, Levels<std::vector<Vec<D>>>& X) const {
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      const auto& e = entries_[k];
+      State& s = states[k];
+      s.surface.clear();
+      for (Index v : e.nodes) s.surface.push_back(M::to_body(mesh.node(v) - s.centre[0], s.orientation[0], e.data));
+      for (int l = 1; l < X.size(); ++l)
+        if (!X[l].empty()) place_surface(s, k, l, X[l]);
+    }
+  }
+
+  /// After a remesh (`constrain` done): the surface velocity DOFs of every level of U set from
+  /// the rigid velocity (+ slip) of that level on that level's positions.
+  template <class Space>
+  void reset_surface_velocities(const Space& space, const std::vector<State>& states,
+                                const Levels<std::vector<Vec<D>>>& X, Levels<VecX>& U) const {
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      const auto& e = entries_[k];
+      const State& s = states[k];
+      for (int l = 0; l < U.size(); ++l) {
+        if (U[l].size() == 0 || X[l].empty()) continue;
+        for (Index i : e.dofs) {
+          const Vec<D> r = space.velocity().point(i, X[l]) - s.centre[l];
+          const Vec<D> v =
+              M::velocity(s.velocity[l], r) +
+              (M::has_slip(e.data)
+                   ? Vec<D>(M::to_world(M::slip(e.data, M::to_body(r, s.orientation[l], e.data)), s.orientation[l], e.data))
+                   : Vec<D>(Vec<D>::Zero()));
+          for (int d = 0; d < D; ++d) U[l][space.velocity_field(i, d)] = v[d];
+        }
+      }
+    }
+  }
+
+ private:
+  struct Entry {
+    Body data;
+    Index extra = -1;                               // first of its n_dof extra unknowns (free bodies)
+    std::vector<Index> nodes;                       // surface mesh nodes (sorted)
+    std::vector<Index> dofs;                        // surface velocity DOFs
+    std::vector<typename Mesh<D>::Facet> facets;    // surface facets
+    // the step's prediction
+    Velocity Zhat = Velocity::Zero();               // extrapolated (or given) velocity
+    Vec<D> xg_next = Vec<D>::Zero();                // centre at t^{n+1}
+    Orientation th_next{};                          // orientation at t^{n+1}
+  };
+  // M delta_l Z^{n+1} / dt (+ w x I_w w in 3D), at the orientation for t^{n+1}.
+  static Velocity inertia(const Entry& e, const State& s, const StepCoefficients& c, const Velocity& Zn1) {
+    const auto& a = c.flow_bdf;
+    Velocity dZ = a[0] * Zn1;
+    for (int k = 1; k <= c.flow_order; ++k) dZ += a[k] * s.velocity[k - 1];
+    return M::inertia(e.data, e.th_next, Zn1, dZ, c.dt);
+  }
+  static Velocity weight(const Entry& e, const Vec<D>& gravity) {
+    Velocity w = Velocity::Zero();
+    w.template head<D>() = M::mass(e.data) * gravity;
+    return w;
+  }
+
+  std::vector<Entry> entries_;
+};
+
+}  // namespace alefsi

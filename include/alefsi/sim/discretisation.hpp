@@ -1,0 +1,131 @@
+#pragma once
+/// \file sim/discretisation.hpp
+/// Everything of a flow that is tied to the mesh topology: the velocity/pressure space, the
+/// element kernel, the mesh-motion operator, the constraints of the flow system (Dirichlet
+/// walls, body links, a pinned pressure), the assembler's sparsity pattern, the system matrix
+/// and the linear solver's analysis. `rebuild(mesh)` after a topology change drops them all;
+/// `constrain(dirichlet, bodies)` then builds the constraints and the pattern.
+///
+/// The space, the kernel and the motion operator keep a pointer to the mesh given to
+/// `rebuild`: it must outlive them (AleFlow owns both).
+///
+/// A solver that accepts the saddle-point blocks of the space (`set_blocks`, e.g.
+/// SaddlePointGmres) gets them here: the pressure mass matrix and, for a time step, the lumped
+/// velocity mass with gamma = rho a_0 / (theta dt), refreshed when the pattern or gamma
+/// changes (`prepare_solver`).
+///
+///     Discretisation<Cfg> disc(mesh, options);            // or (mesh, options, solver options)
+///     disc.constrain(dirichlet, bodies);
+///     disc.assembler().assemble(disc.kernel(), field, &disc.jacobian(), &r);
+#include <map>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "alefsi/fem/constraints.hpp"
+#include "alefsi/fem/dofmap.hpp"
+#include "alefsi/la/assembler.hpp"
+#include "alefsi/la/krylov.hpp"
+#include "alefsi/mesh/mesh.hpp"
+#include "alefsi/physics/mesh_motion.hpp"
+#include "alefsi/physics/navier_stokes.hpp"
+#include "alefsi/sim/config.hpp"
+#include "alefsi/sim/newton.hpp"
+
+namespace alefsi {
+
+/// A solver that takes the space's saddle-point blocks (la/krylov.hpp).
+template <class S>
+concept TakesSaddlePointBlocks = requires(S s, SaddlePointBlocks b) { s.set_blocks(std::move(b)); };
+
+template <FlowConfiguration Cfg>
+class Discretisation {
+ public:
+  static constexpr int D = Cfg::dim;
+  using Space = MixedSpace<D, typename Cfg::Pair>;
+  using Kernel = AleNavierStokesKernel<D, typename Cfg::Pair, Cfg::Equations::convection>;
+  using Motion = ElasticMeshMotion<D>;
+  using Solver = typename Cfg::Solver;
+  using FlowAssembler = Assembler<Space::n_local>;
+
+  /// `solver_args`: the arguments of the solver's constructor (e.g. its options).
+  template <class... SolverArgs>
+  Discretisation(const Mesh<D>& mesh, const FlowOptions& opt, SolverArgs&&... solver_args)
+      : opt_(opt), solve_(std::forward<SolverArgs>(solver_args)...) {
+    rebuild(mesh);
+  }
+  Discretisation(const Discretisation&) = delete;  // the parts point into each other
+  Discretisation& operator=(const Discretisation&) = delete;
+
+  /// A new mesh topology: new space, kernel and motion operator; no constraints or pattern
+  /// until `constrain`; the solver analyses the next matrix afresh.
+  void rebuild(const Mesh<D>& mesh) {
+    space_ = std::make_unique<Space>(mesh);
+    kernel_ = std::make_unique<Kernel>(*space_, opt_.rho, opt_.mu, opt_.linearisation);
+    motion_ = std::make_unique<Motion>(mesh);
+    cons_.reset();
+    asmb_.reset();
+    J_ = SparseMatrix();  // the assembler keeps a matrix whose size matches: a flip keeps the size
+    solve_.reset();
+    gamma_ = -1;
+  }
+
+  /// The constraints of the flow system: velocity DOFs on the tags of `dirichlet` (a map
+  /// keyed by tag) fixed, the bodies' surface DOFs fixed or linked (BodySystem::constrain),
+  /// pressure DOF 0 pinned when every boundary velocity is prescribed; then the pattern.
+  template <class Dirichlet, class Bodies>
+  void constrain(const Dirichlet& dirichlet, Bodies& bodies) {
+    cons_ = std::make_unique<DofConstraints>(space_->n_field());
+    std::vector<char> taken(std::size_t(space_->velocity().n_dofs()), 0);
+    dirichlet_dofs_ = fix_velocity_on_tags(*space_, dirichlet, *cons_, taken);
+    bodies.constrain(*space_, *cons_, taken);
+    // every boundary velocity prescribed (walls or bodies): p is defined up to a constant
+    pinned_ = whole_boundary_prescribed(space_->mesh(),
+                                        [&](int tag) { return bodies.has_tag(tag) || dirichlet.count(tag) > 0; });
+    if (pinned_) cons_->fix(space_->pressure_field(0), 0.0);
+    cons_->finalize();
+    asmb_ = std::make_unique<FlowAssembler>(
+        space_->mesh().n_cells(), [&](Index c) { return space_->cell_field_dofs(c); }, *cons_);
+    asmb_->set_threads(opt_.threads);
+    gamma_ = -1;
+  }
+  bool constrained() const { return cons_ != nullptr; }
+
+  /// Gives a block-aware solver the blocks for a velocity block holding gamma M_u (gamma =
+  /// rho a_0 / (theta dt)); nothing for other solvers.
+  void prepare_solver(Real gamma) {
+    if constexpr (TakesSaddlePointBlocks<Solver>) {
+      if (gamma == gamma_) return;
+      solve_.solver().set_blocks(saddle_point_blocks(*space_, *cons_, opt_.mu, gamma));
+      gamma_ = gamma;
+    }
+  }
+
+  const Space& space() const { return *space_; }
+  Kernel& kernel() { return *kernel_; }
+  Motion& motion() { return *motion_; }
+  DofConstraints& constraints() { return *cons_; }
+  const DofConstraints& constraints() const { return *cons_; }
+  const FlowAssembler& assembler() const { return *asmb_; }
+  SparseMatrix& jacobian() { return J_; }
+  LinearSolve<Solver>& linear_solve() { return solve_; }
+  /// (scalar velocity DOF, tag) of the Dirichlet DOFs.
+  const std::vector<std::pair<Index, int>>& dirichlet_dofs() const { return dirichlet_dofs_; }
+  /// Pressure DOF 0 is pinned (the pressure is shifted to zero mean after each solve).
+  bool pressure_pinned() const { return pinned_; }
+
+ private:
+  FlowOptions opt_;
+  std::unique_ptr<Space> space_;
+  std::unique_ptr<Kernel> kernel_;
+  std::unique_ptr<Motion> motion_;
+  std::unique_ptr<DofConstraints> cons_;
+  std::unique_ptr<FlowAssembler> asmb_;
+  SparseMatrix J_;
+  LinearSolve<Solver> solve_;
+  std::vector<std::pair<Index, int>> dirichlet_dofs_;
+  bool pinned_ = false;
+  Real gamma_ = -1;
+};
+
+}  // namespace alefsi

@@ -1,0 +1,171 @@
+#pragma once
+/// \file sim/flow_state.hpp
+/// The state of an ALE flow between two steps: everything a step reads from the past and
+/// everything a checkpoint writes — and nothing else (the discretisation, the boundary data and
+/// the bodies' descriptions are rebuilt from the scene's configuration).
+///
+///   time      the step-size history (time/history.hpp): t^n, the last step sizes, the levels
+///   X[k]      node positions at t^{n-k} (X[0] is the mesh's; X[1], X[2] empty until taken)
+///   U[k]      field vectors at t^{n-k} (MixedSpace layout: velocity interleaved, then pressure;
+///             the pressure at the scheme's level n - 1 + theta)
+///   V         mesh velocity at t^n (per node)
+///   bodies[b] centre, orientation and velocity Z per level, the last step's hydrodynamic load
+///             and contact force, and the surface node offsets (body frame of the rigid-body
+///             model, one per surface node in the order of the body's surface node list)
+///   stats     steps taken, remeshes, history restarts (and the last step's active contacts,
+///             not written)
+///   remesh    what the remesh trigger remembers of the last remesh
+///
+/// `write_state` / `read_state` put it in / take it from a checkpoint (sim/checkpoint.hpp).
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "alefsi/core/types.hpp"
+#include "alefsi/physics/rigid_body.hpp"
+#include "alefsi/sim/checkpoint.hpp"
+#include "alefsi/sim/remesher.hpp"
+#include "alefsi/time/history.hpp"
+
+namespace alefsi {
+
+/// One rigid body's part of the flow state (levels n, n-1, n-2).
+template <int D, RigidBodyModel M>
+struct BodyState {
+  using Velocity = typename M::Velocity;
+  using Orientation = typename M::Orientation;
+  Levels<Vec<D>> centre;
+  Levels<Orientation> orientation;
+  Levels<Velocity> velocity;  ///< Z
+  Velocity load = Velocity::Zero();  ///< hydrodynamic force and torque over the last step
+  Vec<D> contact = Vec<D>::Zero();   ///< contact force in the last step
+  std::vector<Vec<D>> surface;       ///< surface node offsets from the centre, model frame
+};
+
+/// What the flow did so far (for logs).
+struct FlowStats {
+  int steps = 0, remeshes = 0, history_restarts = 0;
+  int contacts = 0;  ///< active contacts in the last step (not checkpointed)
+};
+
+template <int D, RigidBodyModel M>
+struct FlowState {
+  TimeHistory time;
+  Levels<std::vector<Vec<D>>> X;
+  Levels<VecX> U;
+  std::vector<Vec<D>> V;
+  std::vector<BodyState<D, M>> bodies;
+  FlowStats stats;
+  RemeshMemory remesh;
+};
+
+namespace detail {
+template <int D>
+std::vector<Real> flatten(const std::vector<Vec<D>>& x) {
+  std::vector<Real> out(D * x.size());
+  for (std::size_t i = 0; i < x.size(); ++i)
+    for (int c = 0; c < D; ++c) out[D * i + c] = x[i][c];
+  return out;
+}
+template <int D>
+std::vector<Vec<D>> unflatten(const std::vector<Real>& v) {
+  std::vector<Vec<D>> out(v.size() / D);
+  for (std::size_t i = 0; i < out.size(); ++i)
+    for (int c = 0; c < D; ++c) out[i][c] = v[D * i + c];
+  return out;
+}
+template <class V>
+std::vector<Real> coefficients(const V& v) {
+  return std::vector<Real>(v.data(), v.data() + v.size());
+}
+// A body's orientation: the angle (2D), the quaternion (x, y, z, w) (3D).
+inline void put_orientation(CheckpointWriter& w, Real th) { w.put(th); }
+inline void put_orientation(CheckpointWriter& w, const Eigen::Quaternion<Real>& q) {
+  w.put_vector(std::vector<Real>(q.coeffs().data(), q.coeffs().data() + 4));
+}
+inline void get_orientation(CheckpointReader& r, Real& th) { th = r.get<Real>("body angle"); }
+inline void get_orientation(CheckpointReader& r, Eigen::Quaternion<Real>& q) {
+  const auto c = r.get_vector<Real>("body orientation");
+  if (c.size() != 4) r.fail("bad body record");
+  q = Eigen::Quaternion<Real>(c[3], c[0], c[1], c[2]);
+}
+}  // namespace detail
+
+/// Writes sections "state" and "bodies" (`tags`: the bodies' tags, checked on reading).
+template <int D, RigidBodyModel M>
+void write_state(CheckpointWriter& w, const FlowState<D, M>& s, const std::vector<int>& tags) {
+  w.section("state");
+  w.put(s.time.now());
+  for (Real dt : s.time.steps()) w.put(dt);
+  w.put(std::int32_t(s.time.levels()));
+  w.put(std::int32_t(s.stats.steps));
+  w.put(std::int32_t(s.stats.remeshes));
+  w.put(std::int32_t(s.stats.history_restarts));
+  w.put(s.remesh.quality);
+  w.put(s.remesh.deviation);
+  for (int k = 1; k < s.X.size(); ++k) w.put_vector(detail::flatten(s.X[k]));
+  for (int k = 0; k < s.U.size(); ++k) w.put_vector(s.U[k]);
+  w.put_vector(detail::flatten(s.V));
+  w.section("bodies");
+  w.put(std::uint64_t(s.bodies.size()));
+  for (std::size_t b = 0; b < s.bodies.size(); ++b) {
+    const auto& body = s.bodies[b];
+    w.put(std::int32_t(tags.at(b)));
+    for (int k = 0; k < body.centre.size(); ++k) {
+      w.put_vector(detail::coefficients(body.centre[k]));
+      detail::put_orientation(w, body.orientation[k]);
+      w.put_vector(detail::coefficients(body.velocity[k]));
+    }
+    w.put_vector(detail::coefficients(body.load));
+    w.put_vector(detail::coefficients(body.contact));
+    w.put_vector(detail::flatten(body.surface));
+  }
+}
+
+/// Reads what write_state wrote into `s`, whose bodies are already registered (their count and
+/// tags must match). X[0] is left to the caller (the mesh's nodes); `n_field` is the size the
+/// fields must have.
+template <int D, RigidBodyModel M>
+void read_state(CheckpointReader& r, FlowState<D, M>& s, const std::vector<int>& tags, Index n_field) {
+  r.section("state");
+  const Real t = r.get<Real>("t");
+  std::array<Real, TimeHistory::depth> steps{};
+  for (Real& dt : steps) dt = r.get<Real>("step size");
+  const int levels = r.get<std::int32_t>("levels");
+  if (levels < 0) r.fail("negative number of history levels");
+  s.time.assign(t, levels, steps);
+  s.stats.steps = r.get<std::int32_t>("steps");
+  s.stats.remeshes = r.get<std::int32_t>("remeshes");
+  s.stats.history_restarts = r.get<std::int32_t>("history restarts");
+  s.remesh.quality = r.get<Real>("remesh state");
+  s.remesh.deviation = r.get<Real>("remesh state");
+  for (int k = 1; k < s.X.size(); ++k) s.X[k] = detail::unflatten<D>(r.get_vector<Real>("positions"));
+  for (int k = 0; k < s.U.size(); ++k) s.U[k] = r.get_vecx("field");
+  s.V = detail::unflatten<D>(r.get_vector<Real>("mesh velocity"));
+  if (s.U[0].size() != n_field) r.fail("field size does not match the mesh");
+  r.section("bodies");
+  if (r.get<std::uint64_t>("body count") != s.bodies.size()) r.fail("another number of bodies than this flow's");
+  for (std::size_t b = 0; b < s.bodies.size(); ++b) {
+    auto& body = s.bodies[b];
+    if (r.get<std::int32_t>("body tag") != tags.at(b)) r.fail("body tags differ from this flow's");
+    for (int k = 0; k < body.centre.size(); ++k) {
+      const auto xg = r.get_vector<Real>("body centre");
+      detail::get_orientation(r, body.orientation[k]);
+      const auto Z = r.get_vector<Real>("body velocity");
+      if (xg.size() != std::size_t(D) || Z.size() != std::size_t(M::n_dof)) r.fail("bad body record");
+      for (int c = 0; c < D; ++c) body.centre[k][c] = xg[c];
+      for (int c = 0; c < M::n_dof; ++c) body.velocity[k][c] = Z[c];
+    }
+    const auto load = r.get_vector<Real>("body load");
+    const auto contact = r.get_vector<Real>("body contact");
+    const std::size_t n_surface = body.surface.size();
+    body.surface = detail::unflatten<D>(r.get_vector<Real>("body surface"));
+    if (load.size() != std::size_t(M::n_dof) || contact.size() != std::size_t(D) || body.surface.size() != n_surface)
+      r.fail("bad body record");
+    for (int c = 0; c < M::n_dof; ++c) body.load[c] = load[c];
+    for (int c = 0; c < D; ++c) body.contact[c] = contact[c];
+  }
+}
+
+}  // namespace alefsi

@@ -1,0 +1,111 @@
+#pragma once
+/// \file sim/remesher.hpp
+/// The seam between the flow and mesh adaptation: `Remesher<D>`, and the transfer of a flow's
+/// whole state to a new mesh.
+///
+/// After each step the flow asks its remesher `needed(mesh, bodies, memory)`: whether the mesh
+/// must be adapted, given what the last remesh left (`RemeshMemory`, kept in the flow state and
+/// checkpointed, so that a trigger with hysteresis restarts bit for bit). If so,
+/// `adapt(mesh, bodies, velocity_degree)` returns the new mesh and a `MeshTransfer<D>` from the
+/// old one (or nothing if the adaptation changed nothing), and the flow:
+///   1. interpolates every history level in the current configuration (`transfer_levels`:
+///      positions X^{n-1}, X^{n-2} and the mesh velocity V^n by P1, the fields U^{n-k} by the
+///      velocity and pressure degrees; the new X^n is the new mesh's nodes);
+///   2. rebuilds the discretisation on the new topology;
+///   3. resets each body's surface nodes and surface velocity DOFs, at every level, from its
+///      exact rigid motion (sim/body_system.hpp), so bodies keep their shape;
+///   4. stores `measure(new mesh)` as the memory.
+/// Bodies are given as `RemeshBody<D>` (tag, centre at t^n, radius > 0 for a disk / sphere,
+/// whose surface the remesher keeps exact).
+///
+/// Remeshers: `Remesher2D` (sim/remesher2d.hpp: split / collapse / flip / smoothing with disks on
+/// their exact circles). A 3D remesher implements the same three functions (issue 15).
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "alefsi/core/types.hpp"
+#include "alefsi/mesh/mesh.hpp"
+
+namespace alefsi {
+
+/// A body as the remesher sees it, at t^n.
+template <int D>
+struct RemeshBody {
+  int tag = 0;
+  Vec<D> centre = Vec<D>::Zero();
+  Real radius = 0;  ///< > 0: a disk / sphere, kept exact
+};
+
+/// What the trigger remembers of the last remesh: the quantities `measure` returned then.
+struct RemeshMemory {
+  Real quality = 1;    ///< worst cell quality
+  Real deviation = 0;  ///< worst relative deviation of an edge from the size function
+};
+
+/// Interpolation from the old mesh's Lagrange spaces to the new mesh's.
+template <int D>
+class MeshTransfer {
+ public:
+  virtual ~MeshTransfer() = default;
+  /// A field of the degree-`degree` Lagrange space with `components` interleaved components
+  /// per DOF (DofMap numbering: nodes, then edges).
+  virtual std::vector<Real> apply(const std::vector<Real>& values, int components, int degree) const = 0;
+};
+
+template <int D>
+struct Remeshed {
+  Mesh<D> mesh;
+  std::unique_ptr<MeshTransfer<D>> transfer;
+};
+
+template <int D>
+class Remesher {
+ public:
+  virtual ~Remesher() = default;
+  /// False: the flow never remeshes by itself (an explicit `AleFlow::remesh()` still does).
+  virtual bool enabled() const = 0;
+  /// The trigger's quantities on `mesh` (remembered after a remesh).
+  virtual RemeshMemory measure(const Mesh<D>& mesh, const std::vector<RemeshBody<D>>& bodies) const = 0;
+  /// Whether the mesh should be adapted now, given the memory of the last remesh.
+  virtual bool needed(const Mesh<D>& mesh, const std::vector<RemeshBody<D>>& bodies, const RemeshMemory& last) const = 0;
+  /// The adapted mesh and the transfer to it, or nothing when the mesh did not change.
+  virtual std::optional<Remeshed<D>> adapt(const Mesh<D>& mesh, const std::vector<RemeshBody<D>>& bodies,
+                                           int velocity_degree) = 0;
+};
+
+/// Smallest Mesh::quality over the cells.
+template <int D>
+Real worst_quality(const Mesh<D>& mesh) {
+  Real q = 1;
+  for (Index c = 0; c < mesh.n_cells(); ++c) q = std::min(q, mesh.quality(c));
+  return q;
+}
+
+/// Step 1 above: every history level of `state` interpolated from `old_space`'s mesh by `T`,
+/// in place. Levels not yet taken (empty) stay empty. X^n is left to the caller (the new
+/// mesh's nodes).
+template <class State, class Space>
+void transfer_levels(State& state, const Space& old_space, const MeshTransfer<Space::dim>& T) {
+  constexpr int D = Space::dim;
+  const int kv = Space::VelocityElement::degree, kp = Space::PressureElement::degree;
+  auto move_points = [&](std::vector<Vec<D>>& x) {
+    if (x.empty()) return;
+    std::vector<Real> flat(D * x.size());
+    for (std::size_t i = 0; i < x.size(); ++i)
+      for (int c = 0; c < D; ++c) flat[D * i + c] = x[i][c];
+    flat = T.apply(flat, D, 1);
+    x.resize(flat.size() / D);
+    for (std::size_t i = 0; i < x.size(); ++i)
+      for (int c = 0; c < D; ++c) x[i][c] = flat[D * i + c];
+  };
+  for (int k = 1; k < state.X.size(); ++k) move_points(state.X[k]);
+  move_points(state.V);
+  for (int k = 0; k < state.U.size(); ++k) {
+    VecX& u = state.U[k];
+    if (u.size() == 0) continue;
+    u = Space::join(T.apply(old_space.velocity_values(u), D, kv), T.apply(old_space.pressure_values(u), 1, kp));
+  }
+}
+
+}  // namespace alefsi

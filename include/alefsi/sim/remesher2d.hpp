@@ -1,0 +1,112 @@
+#pragma once
+/// \file sim/remesher2d.hpp
+/// The 2D remesher behind the `Remesher<2>` seam (sim/remesher.hpp): mesh/adapt/adapt2d.hpp's
+/// split / collapse / flip / smoothing adaptation, disks kept on their exact circles (other
+/// bodies' surfaces kept as they are), and FieldTransfer2D for the state.
+///
+/// Trigger (RemeshOptions): the worst cell quality (Mesh::quality) below `trigger_quality`, or,
+/// with a size function, an edge off its size band (|L - h| / h > adapt.tolerance); with
+/// hysteresis: what the last adaptation could not bring inside the band (e.g. the cells in a
+/// gap narrower than h) triggers again only once it got worse by 10 %.
+///
+///     flow.set_remeshing({.walls = {channel_outline(2, 6)},
+///                         .size = [](const auto& disks) { return graded_size(disks, 0.02, 0.2); }});
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "alefsi/core/error.hpp"
+#include "alefsi/mesh/adapt/adapt2d.hpp"
+#include "alefsi/mesh/adapt/transfer.hpp"
+#include "alefsi/sim/remesher.hpp"
+
+namespace alefsi {
+
+/// Remeshing in the time loop (2D).
+struct RemeshOptions {
+  bool enabled = true;
+  Real trigger_quality = 0.35;  ///< in [0, 1)
+  /// The fixed outer boundary (walls) as curves, at their place (mesh/generate/mesher2d.hpp).
+  std::vector<BoundaryCurve> walls;
+  /// Target edge length for the bodies' current circles (disk bodies, radius > 0), e.g.
+  /// `[](const auto& disks) { return graded_size(disks, 0.02, 0.2); }`. Empty: the paper's
+  /// comparative value (adapt2d.hpp) and the quality trigger only.
+  std::function<SizeFunction(const std::vector<Circle>& disks)> size;
+  AdaptOptions adapt;  ///< tolerance T, min_quality, smoothing (adapt.size is set from `size`)
+
+  void validate() const {
+    ALEFSI_CHECK_ARG(trigger_quality >= 0 && trigger_quality < 1, "remesh.trigger_quality",
+                     "must be in [0, 1), got ", trigger_quality);
+  }
+};
+
+class Remesher2D final : public Remesher<2> {
+ public:
+  explicit Remesher2D(RemeshOptions opt) : opt_(std::move(opt)) { opt_.validate(); }
+
+  bool enabled() const override { return opt_.enabled; }
+  const RemeshOptions& options() const { return opt_; }
+  /// The report of the last adaptation.
+  const AdaptReport& last_report() const { return last_; }
+
+  RemeshMemory measure(const Mesh<2>& mesh, const std::vector<RemeshBody<2>>& bodies) const override {
+    Real dev = 0;
+    if (opt_.size) {
+      const SizeFunction h = opt_.size(disks(bodies));
+      for (const auto& e : mesh.edges()) {
+        const Vec<2> a = mesh.node(e[0]), c = mesh.node(e[1]);
+        const Real E = h(0.5 * (a + c));
+        dev = std::max(dev, std::abs((a - c).norm() - E) / E);
+      }
+    }
+    return {worst_quality(mesh), dev};
+  }
+
+  bool needed(const Mesh<2>& mesh, const std::vector<RemeshBody<2>>& bodies, const RemeshMemory& last) const override {
+    const auto [q, dev] = measure(mesh, bodies);
+    const Real q_lim = std::min(opt_.trigger_quality, 0.9 * last.quality);
+    const Real dev_lim = std::max(opt_.adapt.tolerance, 1.1 * last.deviation);
+    return q < q_lim || (opt_.size && dev > dev_lim);
+  }
+
+  std::optional<Remeshed<2>> adapt(const Mesh<2>& mesh, const std::vector<RemeshBody<2>>& bodies,
+                                   int velocity_degree) override {
+    std::vector<BoundaryCurve> curves = opt_.walls;
+    const std::vector<Circle> circles = disks(bodies);
+    curves.insert(curves.end(), circles.begin(), circles.end());
+    AdaptOptions ao = opt_.adapt;
+    if (opt_.size) ao.size = opt_.size(circles);
+    Mesh<2> m2 = alefsi::adapt(mesh, curves, ao, &last_);
+    if (!last_.changed) return std::nullopt;
+    auto T = std::make_unique<Transfer>(mesh, m2, velocity_degree);
+    return Remeshed<2>{std::move(m2), std::move(T)};
+  }
+
+ private:
+  // P1 and P<velocity degree> interpolation plans, built once per remesh.
+  struct Transfer final : MeshTransfer<2> {
+    Transfer(const Mesh<2>& from, const Mesh<2>& to, int degree) : p1(from, to, 1) {
+      if (degree != 1) pk.emplace(from, to, degree);
+    }
+    std::vector<Real> apply(const std::vector<Real>& values, int components, int degree) const override {
+      if (degree == 1) return p1.apply(values, components);
+      ALEFSI_ASSERT(pk && pk->degree() == degree);
+      return pk->apply(values, components);
+    }
+    FieldTransfer2D p1;
+    std::optional<FieldTransfer2D> pk;
+  };
+  // the disk bodies as circles at their place at t^n
+  static std::vector<Circle> disks(const std::vector<RemeshBody<2>>& bodies) {
+    std::vector<Circle> out;
+    for (const auto& b : bodies)
+      if (b.radius > 0) out.push_back(Circle{b.centre, b.radius, b.tag});
+    return out;
+  }
+
+  RemeshOptions opt_;
+  AdaptReport last_;
+};
+
+}  // namespace alefsi

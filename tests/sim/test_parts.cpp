@@ -1,0 +1,371 @@
+// The parts of sim/ alone, each without a flow: the rigid-body model concept (every member is
+// required), the body rows against finite differences, the Newton driver on a small residual,
+// the 2D contact model's forces (formula, momentum balance, overlaps, gaps), the remesh trigger
+// with hysteresis and the transfer of a state (exact for fields the spaces contain), and the
+// flow state's checkpoint round trip.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+#include <string>
+
+#include "alefsi/fem/dofmap.hpp"
+#include "alefsi/mesh/io/gmsh.hpp"
+#include "alefsi/mesh/generate/mesher2d.hpp"
+#include "alefsi/mesh/generate/structured.hpp"
+#include "alefsi/physics/stokes.hpp"
+#include "alefsi/sim/body_system.hpp"
+#include "alefsi/sim/contact2d.hpp"
+#include "alefsi/sim/flow_state.hpp"
+#include "alefsi/sim/newton.hpp"
+#include "alefsi/sim/remesher2d.hpp"
+
+using namespace alefsi;
+
+// ---- the rigid-body model concept: a model lacking any one member is rejected ---------------
+namespace {
+// RigidBodyTraits<2> with member number `Omit` removed (-1: none).
+template <int Omit>
+struct PartialModel {
+  using T = RigidBodyTraits<2>;
+  using Body = T::Body;
+  using Velocity = T::Velocity;
+  using Orientation = T::Orientation;
+  static constexpr int dim = 2, n_dof = 3;
+  static constexpr auto orientation_columns = T::orientation_columns;
+  static constexpr auto velocity_columns = T::velocity_columns;
+  static constexpr auto load_columns = T::load_columns;
+  // clang-format off
+  static int tag(const Body& b) requires(Omit != 0) { return T::tag(b); }
+  static bool is_free(const Body& b) requires(Omit != 1) { return T::is_free(b); }
+  static void validate(const Body& b, std::size_t i) requires(Omit != 2) { T::validate(b, i); }
+  static Vec<2> initial_centre(const Body& b) requires(Omit != 3) { return T::initial_centre(b); }
+  static Velocity initial_velocity(const Body& b, Real t) requires(Omit != 4) { return T::initial_velocity(b, t); }
+  static Velocity prescribed_velocity(const Body& b, Real t) requires(Omit != 5) { return T::prescribed_velocity(b, t); }
+  static bool has_slip(const Body& b) requires(Omit != 6) { return T::has_slip(b); }
+  static Vec<2> slip(const Body& b, const Vec<2>& r) requires(Omit != 7) { return T::slip(b, r); }
+  static Real mass(const Body& b) requires(Omit != 8) { return T::mass(b); }
+  static Velocity external_load(const Body& b) requires(Omit != 9) { return T::external_load(b); }
+  static Real radius(const Body& b) requires(Omit != 10) { return T::radius(b); }
+  static Orientation initial_orientation(const Body& b) requires(Omit != 11) { return T::initial_orientation(b); }
+  static Vec<2> initial_offset(const Vec<2>& r, const Body& b) requires(Omit != 12) { return T::initial_offset(r, b); }
+  static Vec<2> to_world(const Vec<2>& r, Orientation th, const Body& b) requires(Omit != 13) { return T::to_world(r, th, b); }
+  static Vec<2> to_body(const Vec<2>& r, Orientation th, const Body& b) requires(Omit != 14) { return T::to_body(r, th, b); }
+  static std::array<Velocity, 2> rows(const Vec<2>& r) requires(Omit != 15) { return T::rows(r); }
+  static Vec<2> velocity(const Velocity& Z, const Vec<2>& r) requires(Omit != 16) { return T::velocity(Z, r); }
+  static Orientation step_back(Orientation th, const Velocity& Z, Real dt) requires(Omit != 17) { return T::step_back(th, Z, dt); }
+  static Orientation advance(const std::array<Orientation, 3>& th, const Velocity& Z, const std::array<Real, 4>& b, int l,
+                             Real dt) requires(Omit != 18) { return T::advance(th, Z, b, l, dt); }
+  static Orientation extrapolate(Orientation a, Orientation b) requires(Omit != 19) { return T::extrapolate(a, b); }
+  static Velocity inertia(const Body& b, Orientation th, const Velocity& Z, const Velocity& dZ, Real dt) requires(Omit != 20) {
+    return T::inertia(b, th, Z, dZ, dt);
+  }
+  static Mat<3> inertia_jacobian(const Body& b, Orientation th, const Velocity& Z, Real a0, Real dt) requires(Omit != 21) {
+    return T::inertia_jacobian(b, th, Z, a0, dt);
+  }
+  static std::array<Real, 1> orientation_values(Orientation th) requires(Omit != 22) { return T::orientation_values(th); }
+  // clang-format on
+};
+constexpr int n_members = 23;
+template <int... K>
+constexpr bool all_rejected(std::integer_sequence<int, K...>) {
+  return (!RigidBodyModel<PartialModel<K>> && ...);
+}
+}  // namespace
+
+TEST_CASE("RigidBodyModel: the complete model is accepted, one lacking any single member is rejected", "[sim][bodies][quick]") {
+  STATIC_REQUIRE(RigidBodyModel<PartialModel<-1>>);
+  STATIC_REQUIRE(all_rejected(std::make_integer_sequence<int, n_members>{}));
+  STATIC_REQUIRE(RigidBodyModel<RigidBodyTraits<3>>);
+}
+
+// ---- body rows -----------------------------------------------------------------------------
+namespace {
+template <int D, class Space, class Bodies, class States>
+void check_body_jacobian(const Space& space, Bodies& bodies, States& states, const ContactModel<D>& contact,
+                         const StepCoefficients& c, const Vec<D>& g) {
+  DofConstraints cons(space.n_field());
+  std::vector<char> taken(std::size_t(space.velocity().n_dofs()), 0);
+  bodies.constrain(space, cons, taken);
+  cons.finalize();
+  const Index n = cons.n_unknowns();
+  VecX u = VecX::Zero(n);
+  for (Index i = 0; i < n; ++i) u[i] = 0.3 * std::sin(1.7 * i + 0.4);
+  auto rows = [&](const VecX& uu, SparseMatrix& J) {
+    VecX r = VecX::Zero(n);
+    J.resize(n, n);
+    J.setZero();
+    bodies.add_rows(states, c, cons, uu, r, J, g, contact, 0.1);
+    return r;
+  };
+  SparseMatrix J;
+  const VecX r = rows(u, J);
+  constexpr int nd = Bodies::n_dof;
+  Real worst = 0;
+  for (std::size_t b = 0; b < bodies.size(); ++b) {
+    const Index e0 = cons.n_free() + Index(b) * nd;  // bodies are all free here
+    for (int j = 0; j < nd; ++j) {
+      const Real h = 1e-6;
+      VecX up = u, um = u;
+      up[e0 + j] += h, um[e0 + j] -= h;
+      SparseMatrix Jp;
+      const VecX fd = (rows(up, Jp) - rows(um, Jp)) / (2 * h);
+      for (int i = 0; i < nd; ++i) worst = std::max(worst, std::abs(J.coeff(e0 + i, e0 + j) - fd[e0 + i]) / (1 + std::abs(fd[e0 + i])));
+    }
+  }
+  INFO(D << "D worst relative difference of the body blocks " << worst);
+  CHECK(worst < 1e-7);
+  CHECK(r.allFinite());
+}
+}  // namespace
+
+TEST_CASE("body rows: the body blocks of add_rows match finite differences (2D with contact forces, 3D gyroscopic)",
+          "[sim][bodies][quick]") {
+  SECTION("2D: two disks within the contact range") {
+    const Real R = 0.25;
+    const std::vector<Circle> disks = {{Vec<2>(0.7, 1), R, 5}, {Vec<2>(1.27, 1.01), R, 6}};
+    const Mesh<2> mesh = channel_with_disks(2, 2, disks, 0.05, 0.3);
+    MixedSpace<2, TaylorHood> space(mesh);
+    BodySystem<2, RigidBodyTraits<2>> bodies;
+    std::vector<BodyState<2, RigidBodyTraits<2>>> states;
+    for (const auto& d : disks) bodies.add(disk_body(d.tag, d.centre, R, 1.5), mesh, 0.0, states);
+    states[0].velocity.fill(Vec<3>(0.4, 0.1, 0.3));
+    states[1].velocity.fill(Vec<3>(-0.5, 0.2, -0.1));
+    bodies.attach(mesh);
+    const StepCoefficients c = step_coefficients<BDF2_BDF2E>(0.01, TimeHistory{});
+    NodeVelocities<2> nodes;
+    bodies.mesh_velocity_data(states, mesh.coordinates(), c.extrapolation, 0.01, nodes);
+    std::vector<Vec<2>> x = mesh.coordinates();
+    bodies.advance(states, c, x);
+    CollisionContact2D contact(CollisionOptions{.range = 0.5, .spring_range = 0.1, .spring_force = 3});
+    contact.set_walls(mesh, bodies.tags());
+    REQUIRE(contact.find(bodies.contact_bodies(states, -1), 0.01) == 1);
+    check_body_jacobian<2>(space, bodies, states, contact, c, Vec<2>(0, -9.81));
+    // momentum balance: the contact forces on the two bodies cancel
+    CHECK((states[0].contact + states[1].contact).norm() <= 1e-14 * states[0].contact.norm());
+    CHECK(states[0].contact.norm() > 0);
+  }
+  SECTION("3D: a free anisotropic body turning off its principal axes") {
+    const Mesh<3> mesh = read_gmsh<3>(std::string(ALEFSI_TEST_DATA_DIR) + "/gmsh/sphere_in_box3d.msh").mesh;
+    MixedSpace<3, P1P1Gls> space(mesh);
+    BodySystem<3, RigidBodyTraits<3>> bodies;
+    std::vector<BodyState<3, RigidBodyTraits<3>>> states;
+    RigidBody3D body = sphere_body(5, Vec<3>::Zero(), 0.2, 2.0);
+    body.inertia = Vec<3>(0.01, 0.02, 0.035).asDiagonal();
+    body.orientation = Eigen::Quaternion<Real>(Eigen::AngleAxis<Real>(0.4, Vec<3>(1, 2, 3).normalized()));
+    bodies.add(body, mesh, 0.0, states);
+    Vec<6> Z;
+    Z << 0.1, -0.2, 0.3, 1.5, -0.7, 2.0;
+    states[0].velocity.fill(Z);
+    bodies.attach(mesh);
+    const StepCoefficients c = step_coefficients<BDF3_BDF3E>(0.02, TimeHistory{});
+    NodeVelocities<3> nodes;
+    bodies.mesh_velocity_data(states, mesh.coordinates(), c.extrapolation, 0.02, nodes);
+    std::vector<Vec<3>> x = mesh.coordinates();
+    bodies.advance(states, c, x);
+    NoContact<3> none;
+    check_body_jacobian<3>(space, bodies, states, none, c, Vec<3>(0, 0, -1));
+  }
+}
+
+// ---- Newton --------------------------------------------------------------------------------
+namespace {
+struct DenseLu {  // a LinearSolver for tiny systems
+  static constexpr const char* name = "dense LU";
+  Eigen::PartialPivLU<MatX> lu;
+  void analyze(const SparseMatrix&) {}
+  void factorize(const SparseMatrix& A) { lu.compute(MatX(A)); }
+  VecX solve(const VecX& b) { return lu.solve(b); }
+};
+}  // namespace
+
+TEST_CASE("newton_solve: quadratic convergence on a small system, typed failures", "[sim][newton][quick]") {
+  // r(u) = (u0^2 + u1^2 - 4, u0 - u1^3 + 1): root near (1.69, 1.08)
+  auto residual = [](const VecX& u, SparseMatrix& J, VecX& r) {
+    r.resize(2);
+    r << u[0] * u[0] + u[1] * u[1] - 4, u[0] - u[1] * u[1] * u[1] + 1;
+    MatX Jd(2, 2);
+    Jd << 2 * u[0], 2 * u[1], 1, -3 * u[1] * u[1];
+    J = Jd.sparseView();
+  };
+  LinearSolve<DenseLu> lin;
+  VecX u(2);
+  u << 1, 1;
+  SparseMatrix J;
+  const NewtonReport rep = newton_solve(residual, lin, J, u, {.tolerance = 1e-14});
+  const auto& e = rep.residuals;
+  REQUIRE(e.size() >= 4);
+  CHECK(e.back() < 1e-13);
+  // quadratic: e_{k+1} / e_k^2 bounded once close
+  CHECK(e[e.size() - 2] < 10 * e[e.size() - 3] * e[e.size() - 3]);
+  VecX r;
+  residual(u, J, r);
+  CHECK(r.norm() < 1e-13);
+  // linear mode: exactly one update
+  VecX v(2);
+  v << 1, 1;
+  CHECK(newton_solve(residual, lin, J, v, {.linear = true}).iterations == 1);
+  // failures: too few iterations, a non-finite residual
+  VecX w(2);
+  w << 1, 1;
+  CHECK_THROWS_WITH(newton_solve(residual, lin, J, w, {.max_iterations = 1, .tolerance = 1e-14}),
+                    Catch::Contains("did not converge in 1 iterations") && Catch::Contains("e-"));
+  VecX bad(2);
+  bad << std::nan(""), 1;
+  CHECK_THROWS_AS(newton_solve(residual, lin, J, bad, {}), SolverError);
+}
+
+// ---- the 2D contact model --------------------------------------------------------------------
+namespace {
+ContactBody<2> disk_at(Vec<2> c, Real r, Vec<2> v = Vec<2>::Zero()) {
+  ContactBody<2> b;
+  b.centre = c, b.velocity = v, b.radius = b.r_in = b.r_out = r;
+  return b;
+}
+}  // namespace
+
+TEST_CASE("CollisionContact2D: eq. (24) + spring through the seam, momentum balance, overlaps and gaps",
+          "[sim][collision][quick]") {
+  const Real R = 0.125, mu = 0.01, d = 0.01;
+  const Mesh<2> box = rectangle_mesh(4, 4, 0, 2, 0, 2);
+  CollisionContact2D model({.range = 0.1, .spring_range = 0.02, .spring_force = 7});
+  model.set_walls(box, {});
+  std::vector<ContactBody<2>> b = {disk_at({1, 1}, R), disk_at({1, 1 + 2 * R + d}, R)};
+  REQUIRE(model.find(b, mu) == 1);
+  const std::vector<Vec<2>> v = {Vec<2>(0, 3), Vec<2>(0, -2)};
+  std::vector<Vec<2>> F(2, Vec<2>::Zero());
+  int visits = 0;
+  model.forces(v, [&](int k, const Vec<2>& f, const Mat<2>&) { F[k] += f, ++visits; });
+  CHECK(visits == 2);
+  const Real s = 1 - d / 0.02;
+  const Real expected = mu * std::pow(4 * R / d, 1.5) * 5.0 + 7 * s * s;
+  CHECK(F[1].norm() == Approx(expected).epsilon(1e-12));
+  CHECK(F[1][1] > 0);                    // repulsive: the upper disk is pushed up
+  CHECK((F[0] + F[1]).norm() == 0.0);    // action = reaction
+  // overlaps between bodies, gaps to bodies and walls
+  CHECK(model.overlaps(b).empty());
+  b[1].centre[1] = 1 + 2 * R - 1e-3;
+  const auto o = model.overlaps(b);
+  REQUIRE(o.size() == 1);
+  CHECK(o[0].gap == Approx(-1e-3).epsilon(1e-9));
+  b = {disk_at({1, 0.3}, R), disk_at({1, 1.5}, R)};
+  const auto g = model.gaps(b);
+  CHECK(g[0] == Approx(0.3 - R).epsilon(1e-12));          // the bottom wall
+  CHECK(g[1] == Approx(2 - 1.5 - R).epsilon(1e-12));      // the top wall
+  // geometry only: no forces
+  CollisionContact2D geometry;
+  geometry.set_walls(box, {});
+  CHECK(geometry.find(b, mu) == 0);
+  CHECK(NoContact<3>().gaps(std::vector<ContactBody<3>>(2))[1] == std::numeric_limits<Real>::infinity());
+}
+
+// ---- the remesher ----------------------------------------------------------------------------
+TEST_CASE("Remesher2D: the trigger's hysteresis, and a transferred state exact for fields the spaces contain",
+          "[sim][remesh][quick]") {
+  const Real R = 0.2;
+  const std::vector<Circle> disks = {{Vec<2>(1, 1), R, 5}};
+  Mesh<2> mesh = channel_with_disks(2, 2, disks, 0.08, 0.3);
+  Remesher2D remesher({.walls = {channel_outline(2, 2)},
+                       .size = [](const std::vector<Circle>& c) { return graded_size(c, 0.03, 0.12); },
+                       .adapt = {}});
+  const std::vector<RemeshBody<2>> bodies = {{5, Vec<2>(1, 1), R}};
+  // a size function far from the mesh's: triggered; what the adaptation could not fix does not
+  // trigger again unless it gets 10 % worse
+  const RemeshMemory fresh{};
+  CHECK(remesher.needed(mesh, bodies, fresh));
+  const RemeshMemory m = remesher.measure(mesh, bodies);
+  CHECK(!remesher.needed(mesh, bodies, {m.quality, m.deviation}));
+  CHECK(remesher.needed(mesh, bodies, {m.quality, m.deviation / 1.2}));
+
+  using Space = MixedSpace<2, TaylorHood>;
+  const Space old_space(mesh);
+  auto out = remesher.adapt(mesh, bodies, 2);
+  REQUIRE(out);
+  const Space new_space(out->mesh);
+  // velocity quadratic, pressure affine, positions and mesh velocity affine
+  auto u_of = [](const Vec<2>& x) { return Vec<2>(x[0] * x[1] - 0.3 * x[1] * x[1], 1 + x[0] * x[0]); };
+  auto p_of = [](const Vec<2>& x) { return 2 * x[0] - x[1] + 0.5; };
+  auto fill = [&](const Space& sp, VecX& f) {
+    f.resize(sp.n_field());
+    for (Index i = 0; i < sp.velocity().n_dofs(); ++i)
+      for (int c = 0; c < 2; ++c) f[sp.velocity_field(i, c)] = u_of(sp.velocity().point(i))[c];
+    for (Index i = 0; i < sp.pressure().n_dofs(); ++i) f[sp.pressure_field(i)] = p_of(sp.pressure().point(i));
+  };
+  auto affine = [](const Vec<2>& x) { return Vec<2>(0.5 * x[0] + 0.1, -x[1] + 2 * x[0]); };
+  FlowState<2, RigidBodyTraits<2>> s;
+  fill(old_space, s.U[0]);
+  s.U[1] = s.U[0];
+  for (const auto& x : mesh.coordinates()) s.X[1].push_back(affine(x)), s.V.push_back(affine(x));
+  transfer_levels(s, old_space, *out->transfer);
+  VecX exact;
+  fill(new_space, exact);
+  // inside the old mesh the transfer is exact; new nodes on the circle lie O(h^2) outside it
+  Real worst_u = 0, worst_x = 0;
+  for (Index i = 0; i < new_space.velocity().n_dofs(); ++i) {
+    const Vec<2> x = new_space.velocity().point(i);
+    if ((x - Vec<2>(1, 1)).norm() < R + 0.02) continue;
+    for (int c = 0; c < 2; ++c)
+      worst_u = std::max(worst_u, std::abs(s.U[0][new_space.velocity_field(i, c)] - exact[new_space.velocity_field(i, c)]));
+  }
+  for (Index v = 0; v < out->mesh.n_nodes(); ++v) {
+    const Vec<2> x = out->mesh.node(v);
+    if ((x - Vec<2>(1, 1)).norm() < R + 0.02) continue;
+    worst_x = std::max({worst_x, (s.X[1][v] - affine(x)).norm(), (s.V[v] - affine(x)).norm()});
+  }
+  CHECK(worst_u < 1e-12);
+  CHECK(worst_x < 1e-12);
+  CHECK(s.U[1] == s.U[0]);
+  CHECK(s.X[2].empty());  // a level not yet taken stays empty
+}
+
+// ---- the flow state in a checkpoint ------------------------------------------------------------
+TEST_CASE("FlowState: write_state / read_state round trip, and a mismatched body tag is refused", "[sim][checkpoint][quick]") {
+  using State = FlowState<3, RigidBodyTraits<3>>;
+  State s;
+  s.time.advance(0.1), s.time.advance(0.05);
+  s.X[1] = {Vec<3>(1, 2, 3), Vec<3>(4, 5, 6)};
+  s.U[0] = VecX::LinSpaced(7, 0, 1), s.U[1] = VecX::Constant(7, 2), s.U[2] = VecX();
+  s.V = {Vec<3>(0, 1, 0), Vec<3>(1, 0, 0)};
+  s.stats.steps = 2, s.stats.remeshes = 1;
+  s.remesh = {0.4, 0.8};
+  BodyState<3, RigidBodyTraits<3>> b;
+  b.centre.fill(Vec<3>(0.1, 0.2, 0.3));
+  b.orientation.fill(Eigen::Quaternion<Real>(Eigen::AngleAxis<Real>(0.3, Vec<3>::UnitZ())));
+  b.velocity.fill(Vec<6>::LinSpaced(6, 1, 6));
+  b.load = Vec<6>::Constant(-1);
+  b.surface = {Vec<3>(0.2, 0, 0)};
+  s.bodies.push_back(b);
+  const auto file = std::filesystem::temp_directory_path() / "alefsi_test_state.bin";
+  {
+    CheckpointWriter w(file);
+    write_state(w, s, {7});
+    w.commit();
+  }
+  State r;
+  r.bodies.resize(1);
+  r.bodies[0].surface.resize(1);
+  {
+    CheckpointReader rd(file);
+    read_state(rd, r, {7}, 7);
+    rd.finish();
+  }
+  CHECK(r.time.now() == s.time.now());
+  CHECK(r.time.levels() == 2);
+  CHECK(r.time.steps() == s.time.steps());
+  CHECK(r.X[1] == s.X[1]);
+  CHECK(r.U[0] == s.U[0]);
+  CHECK(r.U[1] == s.U[1]);
+  CHECK(r.V == s.V);
+  CHECK(r.stats.steps == 2);
+  CHECK(r.remesh.deviation == 0.8);
+  CHECK(r.bodies[0].orientation[2].coeffs() == b.orientation[2].coeffs());
+  CHECK(r.bodies[0].velocity[1] == b.velocity[1]);
+  CHECK(r.bodies[0].load == b.load);
+  State wrong;
+  wrong.bodies.resize(1);
+  wrong.bodies[0].surface.resize(1);
+  CheckpointReader rd(file);
+  CHECK_THROWS_WITH(read_state(rd, wrong, {8}, 7), Catch::Contains("body tags"));
+  std::filesystem::remove(file);
+}

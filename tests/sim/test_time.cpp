@@ -1,0 +1,137 @@
+// The time layer alone: the step-size history, the stepper's coefficients (constant-step tables,
+// variable-step formulas against their defining property), the start-up plan, and the
+// scheme-name dispatch.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+
+#include "alefsi/time.hpp"
+
+using namespace alefsi;
+
+namespace {
+TimeHistory history(std::initializer_list<Real> steps) {  // oldest first
+  TimeHistory h;
+  for (Real dt : steps) h.advance(dt);
+  return h;
+}
+}  // namespace
+
+TEST_CASE("TimeHistory keeps t^n, the step sizes as taken and the levels since the last restart", "[time][quick]") {
+  TimeHistory h(1.0);
+  CHECK(h.levels() == 0);
+  CHECK(h.last_step() == 0);
+  h.advance(0.1);
+  h.advance(0.2);
+  h.advance(0.3);
+  h.advance(0.4);
+  CHECK(h.now() == Approx(2.0).epsilon(1e-15));
+  CHECK(h.levels() == 4);
+  CHECK(h.step(0) == 0.4);
+  CHECK(h.step(1) == 0.3);
+  CHECK(h.step(2) == 0.2);
+  h.restart();
+  CHECK(h.levels() == 0);
+  CHECK(h.now() == Approx(2.0).epsilon(1e-15));
+  Levels<int> l;
+  l.fill(0);
+  l.push(1), l.push(2), l.push(3), l.push(4);
+  CHECK((l[0] == 4 && l[1] == 3 && l[2] == 2));
+}
+
+TEMPLATE_TEST_CASE("constant steps: the coefficients are the scheme's tables, to the last bit", "[time][stepper][quick]",
+                   MR_AB, BDF2_BDF2E, BDF2_AB, BDF3_BDF3E, BSS) {
+  using S = TestType;
+  const TimeHistory h = history({0.01, 0.01, 0.01});
+  const StepCoefficients c = step_coefficients<S>(0.01, h);
+  CHECK(c.flow_bdf == bdf_coefficients(S::flow_bdf));
+  CHECK(c.position_bdf == bdf_coefficients(S::position_bdf));
+  CHECK(c.extrapolation == S::extrapolation);
+  CHECK(c.convection == extrapolation_weights(S::theta < 1 ? 2 : S::flow_bdf, S::theta < 1));
+  CHECK(c.theta == S::theta);
+  CHECK(c.velocity_level == S::velocity_level);
+  CHECK(c.flow_velocity == S::flow_velocity);
+  CHECK(std::string(c.scheme) == S::name);
+}
+
+TEST_CASE("variable steps: BDF2 weights are the closed form with w = dt_n / dt_{n-1}", "[time][stepper][quick]") {
+  const Real dt = 0.03, prev = 0.02, w = dt / prev;
+  const auto a = step_coefficients<BDF2_BDF2E>(dt, history({0.05, prev})).flow_bdf;
+  CHECK(a[0] == Approx((1 + 2 * w) / (1 + w)).epsilon(1e-14));
+  CHECK(a[1] == Approx(-(1 + w)).epsilon(1e-14));
+  CHECK(a[2] == Approx(w * w / (1 + w)).epsilon(1e-14));
+  CHECK(a[3] == 0);
+}
+
+TEST_CASE("variable steps: BDF-l differentiates degree-l polynomials exactly, extrapolations reproduce degree m-1",
+          "[time][stepper][quick]") {
+  // times t^{n+1} = 0.37, steps dt = 0.11 after 0.05, 0.08 (levels t^n, t^{n-1}, t^{n-2})
+  const Real dt = 0.11, t1 = 0.37;
+  const TimeHistory h = history({0.07, 0.08, 0.05});  // last step 0.05, before it 0.08
+  const std::array<Real, 4> t{t1, t1 - dt, t1 - dt - 0.05, t1 - dt - 0.05 - 0.08};
+  for (int l = 1; l <= 3; ++l) {
+    const auto a = variable_bdf_coefficients(l, dt, {0.05, 0.08, 0.07});
+    for (int p = 0; p <= l; ++p) {  // d/dt t^p at t1, times dt
+      Real sum = 0;
+      for (int k = 0; k <= l; ++k) sum += a[k] * std::pow(t[k], p);
+      const Real exact = p == 0 ? 0.0 : dt * p * std::pow(t1, p - 1);
+      CHECK(sum == Approx(exact).margin(1e-13));
+    }
+  }
+  // extrapolation from t^n, t^{n-1}, t^{n-2} to t^n + dt / 2 (MR/AB's level) and to t^{n+1}
+  const StepCoefficients mr = step_coefficients<MR_AB>(dt, h), b3 = step_coefficients<BDF3_BDF3E>(dt, h);
+  for (int p = 0; p <= 2; ++p) {
+    Real e2 = 0, e3 = 0, u3 = 0;
+    for (int k = 0; k < 3; ++k) {
+      e2 += mr.extrapolation[k] * std::pow(t[k + 1], p);
+      e3 += b3.extrapolation[k] * std::pow(t[k + 1], p);
+      u3 += b3.convection[k] * std::pow(t[k + 1], p);
+    }
+    if (p <= 1) CHECK(e2 == Approx(std::pow(t1 - dt / 2, p)).margin(1e-14));
+    CHECK(e3 == Approx(std::pow(t1, p)).margin(1e-14));
+    CHECK(u3 == Approx(std::pow(t1, p)).margin(1e-14));
+  }
+  // the body velocity extrapolation to t^{n+1} is linear
+  CHECK(b3.body_velocity[0] * t[1] + b3.body_velocity[1] * t[2] == Approx(t1).epsilon(1e-14));
+}
+
+TEST_CASE("Stepper: start-up while the history is short, a damped start when asked, restarts on a dt change",
+          "[time][stepper][quick]") {
+  const Stepper<BDF3_BDF3E> bdf3;
+  TimeHistory h;
+  StepPlan p = bdf3.plan(h, 0.01);
+  CHECK(p.kind == StepKind::startup);
+  CHECK(p.coefficients.backfill);
+  CHECK(std::string(p.coefficients.scheme) == MR_AB::name);
+  h.advance(0.01);
+  p = bdf3.plan(h, 0.01);
+  CHECK(p.kind == StepKind::startup);
+  CHECK(!p.coefficients.backfill);
+  h.advance(0.01);
+  CHECK(bdf3.plan(h, 0.01).kind == StepKind::regular);
+  CHECK(Stepper<BDF3_BDF3E>::restarts(h, 0.005));
+  CHECK(!Stepper<BDF3_BDF3E>::restarts(h, 0.01));
+  CHECK(Stepper<BSS>().plan(TimeHistory{}, 0.1).kind == StepKind::regular);  // BSS reads no past level
+
+  const Stepper<BDF3_BDF3E> damped3(4);
+  p = damped3.plan(TimeHistory{}, 0.02);
+  CHECK(p.kind == StepKind::damped_start);
+  CHECK(p.substeps == 4);
+  CHECK(p.richardson);  // order 3: extrapolated
+  CHECK(p.coefficients.dt == 0.005);
+  CHECK(!Stepper<BDF2_BDF2E>(2).plan(TimeHistory{}, 0.02).richardson);
+  CHECK_THROWS_WITH(Stepper<MR_AB>(3), Catch::Contains("damped_start"));
+}
+
+TEST_CASE("dispatch_scheme: display or type name to the scheme type, unknown names listed", "[time][quick]") {
+  CHECK(dispatch_scheme("BDF2/BDF2E", []<class S>() { return S::order; }) == 2);
+  CHECK(dispatch_scheme("BDF3_BDF3E", []<class S>() { return S::order; }) == 3);
+  CHECK(dispatch_scheme("BSS", []<class S>() { return std::string(S::name); }) == "BSS");
+  int calls = 0;
+  dispatch_scheme("MR_AB", [&]<class S>() { calls += S::theta == 0.5; });
+  CHECK(calls == 1);
+  CHECK_THROWS_WITH(dispatch_scheme("BDF4", []<class S>() {}, "--scheme"),
+                    Catch::Contains("--scheme") && Catch::Contains("MR/AB, BDF2/BDF2E, BDF2/AB, BDF3/BDF3E, BSS"));
+  CHECK(scheme_names() == "MR/AB, BDF2/BDF2E, BDF2/AB, BDF3/BDF3E, BSS");
+}

@@ -110,11 +110,14 @@ class Options {
     }
     out << "  " << std::left << std::setw(24) << "--help" << "this text\n";
   }
-  /// One line with the value of every option (for the log of a run).
+  /// One line with the value of every option (for the log of a run), itself a valid command line.
   void print(std::ostream& out) const {
     out << program_;
     for (const auto& p : positional_) out << ' ' << p.get();
-    for (const auto& e : entries_) out << " --" << e.name << ' ' << e.get();
+    for (const auto& e : entries_) {
+      if (e.is_flag) out << (e.get() == "true" ? " --" : " --no-") << e.name;
+      else out << " --" << e.name << ' ' << e.get();
+    }
     out << '\n';
   }
 

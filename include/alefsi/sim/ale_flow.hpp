@@ -49,6 +49,7 @@
 #include "alefsi/sim/contact2d.hpp"
 #include "alefsi/sim/discretisation.hpp"
 #include "alefsi/sim/flow_state.hpp"
+#include "alefsi/sim/kinematics.hpp"
 #include "alefsi/sim/mesh_velocity.hpp"
 #include "alefsi/sim/newton.hpp"
 #include "alefsi/sim/remesher.hpp"
@@ -297,52 +298,33 @@ class AleFlow {
   // One step with the coefficients c (steps 1-5 of the file comment).
   StepReport advance(const StepCoefficients& c) {
     State& s = state_;
-    const Real dt = c.dt, t = s.time.now(), t1 = t + dt;
-    const std::size_t nn = s.X[0].size();
-    if (c.backfill) {  // X^{n-1} = X^n - dt V^n, U^{n-1} = U^n
-      s.X[1] = s.X[0];
-      for (std::size_t i = 0; i < nn; ++i) s.X[1][i] -= dt * s.V[i];
-      s.U[1] = s.U[0];
-      bodies_.backfill(s.bodies, dt);
-    }
-    // 1.-2. extrapolated geometry, mesh velocity at t_V
-    std::vector<Vec<D>> Xh(nn, Vec<D>::Zero());
-    for (int k = 0; k < 3; ++k)
-      if (c.extrapolation[k] != 0)
-        for (std::size_t i = 0; i < nn; ++i) Xh[i] += c.extrapolation[k] * s.X[k][i];
+    const Real t = s.time.now(), t1 = t + c.dt;
+    if (c.backfill) backfill(s, c.dt);
+    // 1.-2. the mesh velocity at t_V on the extrapolated geometry
+    const std::vector<Vec<D>> Xh = extrapolate(s.X, c.extrapolation);
     StepReport rep;
-    auto clock = std::chrono::steady_clock::now();
+    const auto clock = std::chrono::steady_clock::now();
     const Real tV = c.velocity_time(t);
     bodies_.mesh_velocity_data(s.bodies, Xh, c.extrapolation, tV, body_nodes_);
     const std::vector<Vec<D>> Vs = mesh_velocity_.solve(disc_.motion(), mesh_, Xh, tV, body_nodes_);
     rep.t_mesh_velocity = std::chrono::duration<Real>(std::chrono::steady_clock::now() - clock).count();
-    // 3. positions, the mesh velocity the flow sees (and V^{n+1}), the flow geometry X^{n+theta}
-    const auto& b = c.position_bdf;
-    std::vector<Vec<D>> Xn1(nn), Xth(nn);
-    for (std::size_t i = 0; i < nn; ++i) {
-      Vec<D> x = dt * Vs[i];
-      for (int k = 1; k <= c.position_order; ++k) x -= b[k] * s.X[k - 1][i];
-      Xn1[i] = x / b[0];
-    }
-    bodies_.advance(s.bodies, c, Xn1);
-    std::vector<Vec<D>> Vflow = Vs, Vnext = Vs;
-    if (c.velocity_level == VelocityLevel::n_half)
-      for (std::size_t i = 0; i < nn; ++i) Vnext[i] = 2 * Vs[i] - s.V[i];
-    if (c.flow_velocity == FlowMeshVelocity::ab2) Vflow = Vnext;
-    for (std::size_t i = 0; i < nn; ++i) Xth[i] = c.theta * Xn1[i] + (1 - c.theta) * s.X[0][i];
+    // 3. positions (bodies by their rigid map), the flow geometry X^{n+theta}
+    StepNodes<D> g = advance_nodes(s.X, s.V, Vs, c);
+    bodies_.advance(s.bodies, c, g.Xn1);
+    const std::vector<Vec<D>> Xth = flow_geometry(g.Xn1, s.X[0], c.theta);
     mesh_.set_coordinates(Xth);
-    // 4. the flow system at n+theta, solved
     try {
-      const VecX u = solve_flow(c, t1, Xn1, Xth, Vflow, rep);
+      // 4. the flow at n+theta
+      const VecX u = solve_flow(c, t1, g, Xth, rep);
       VecX field = disc_.constraints().expand(u);
       if (disc_.pressure_pinned()) shift_pressure_to_zero_mean(space(), field);
-      mesh_.set_coordinates(Xn1);
+      mesh_.set_coordinates(g.Xn1);
       // 5. the new level
       bodies_.finish(s.bodies, c, disc_.constraints(), u, t1, gravity_);
       s.U.push(std::move(field));
-      s.X.push(std::move(Xn1));
-      s.V = std::move(Vnext);
-      s.time.advance(dt);
+      s.X.push(std::move(g.Xn1));
+      s.V = std::move(g.Vnext);
+      s.time.advance(c.dt);
     } catch (...) {
       mesh_.set_coordinates(s.X[0]);  // the step is rejected: the state stays at t^n
       throw;
@@ -352,38 +334,30 @@ class AleFlow {
 
   // Step 4: Dirichlet data and body links at t1, the kernel's inputs, the contacts, Newton;
   // returns the unknowns.
-  VecX solve_flow(const StepCoefficients& c, Real t1, const std::vector<Vec<D>>& Xn1, const std::vector<Vec<D>>& Xth,
-                  const std::vector<Vec<D>>& Vflow, StepReport& rep) {
+  VecX solve_flow(const StepCoefficients& c, Real t1, const StepNodes<D>& g, const std::vector<Vec<D>>& Xth,
+                  StepReport& rep) {
     State& s = state_;
     DofConstraints& cons = disc_.constraints();
     for (const auto& [i, tag] : disc_.dirichlet_dofs()) {
-      const Vec<D> val = dirichlet_.at(tag)(space().velocity().point(i, Xn1), t1);
+      const Vec<D> val = dirichlet_.at(tag)(space().velocity().point(i, g.Xn1), t1);
       for (int k = 0; k < D; ++k) cons.set_fixed_value(space().velocity_field(i, k), val[k]);
     }
-    bodies_.set_surface_velocities(space(), cons, s.bodies, c, Xn1, Xth, t1);
-    // the BDF history of the time derivative and the extrapolated (convecting) velocity
-    VecX hist = VecX::Zero(s.U[0].size()), ustar = VecX::Zero(s.U[0].size());
-    for (int k = 1; k <= c.flow_order; ++k) hist += c.flow_bdf[k] * s.U[k - 1];
-    for (int k = 0; k < 3; ++k)
-      if (c.convection[k] != 0) ustar += c.convection[k] * s.U[k];
-    StepInputs<D> in;
-    in.dt = c.dt, in.theta = c.theta, in.a0 = c.flow_bdf[0];
-    in.history = &hist, in.previous = &s.U[0], in.extrapolated = &ustar, in.mesh_velocity = &Vflow;
-    const Real tf = s.time.now() + c.theta * c.dt;
+    bodies_.set_surface_velocities(space(), cons, s.bodies, c, g.Xn1, Xth, t1);
+    VectorFunction<D> force;
     if (force_ || gravity_.squaredNorm() > 0)
-      in.force = [this, tf](const Vec<D>& x) {
+      force = [this, tf = s.time.now() + c.theta * c.dt](const Vec<D>& x) {
         Vec<D> f = opt_.rho * gravity_;
         if (force_) f += force_(x, tf);
         return f;
       };
-    disc_.kernel().set_step(in);
+    disc_.set_step(c, s.U, g.Vflow, std::move(force));
     // contacts from the bodies placed at t^{n+1}; positions that overlap reject the step
     const auto placed = bodies_.contact_bodies(s.bodies, -1);
     s.stats.contacts = contact_->find(placed, opt_.mu);
     for (const auto& o : contact_->overlaps(placed))
       throw SolverError("bodies[" + std::to_string(o.k) + "] and bodies[" + std::to_string(o.j) +
                         "] would overlap at t = " + detail::sci(t1) + " (gap " + detail::sci(o.gap) + ")");
-    // Newton (or one semi-implicit solve)
+    // Newton (or one semi-implicit solve) from u^n, Z^n
     disc_.prepare_solver(opt_.rho * c.flow_bdf[0] / (c.theta * c.dt));
     VecX u = cons.restrict_free(s.U[0]);
     bodies_.initial_guess(cons, s.bodies, u);
@@ -395,19 +369,16 @@ class AleFlow {
                            .max_iterations = opt_.max_newton,
                            .tolerance = opt_.newton_tolerance};
     const NewtonReport nr = newton_solve(residual, disc_.linear_solve(), disc_.jacobian(), u, no);
-    rep.newton_iterations = nr.iterations;
-    rep.residuals = nr.residuals;
+    rep.newton_iterations = nr.iterations, rep.residuals = nr.residuals;
     rep.t_assembly = nr.t_assembly, rep.t_factorize = nr.t_factorize, rep.t_solve = nr.t_solve;
     return u;
   }
 
-  // The first step from t^n by plan.substeps backward-Euler substeps (see FlowOptions::
-  // damped_start), Richardson-extrapolated (2 u_{dt/m} - u_{2dt/m}) when plan.richardson: the
-  // positions and fields node by node, the bodies' centre, velocity and orientation likewise
-  // (the orientation by the model), their surface nodes by the exact rigid map. The history
-  // is then t^n (the state before) and t^n + dt, V^n is solved at t^n + dt on X^{n+1}, and a
-  // scheme that reads two past levels (BDF3) takes one MR/AB start-up step next. A substep
-  // that throws leaves the flow at t^n.
+  // The first step from t^n by plan.substeps backward-Euler substeps (FlowOptions::
+  // damped_start), Richardson-extrapolated (2 u_{dt/m} - u_{2dt/m}) when plan.richardson, the
+  // bodies' surface nodes then placed by their exact rigid map; the history is then t^n and
+  // t^n + dt and V^n is solved at t^n + dt on X^{n+1}. A substep that throws leaves the flow
+  // at t^n.
   StepReport damped_start(const StepPlan& plan, Real dt) {
     const State s0 = state_;
     StepReport rep;
@@ -420,34 +391,15 @@ class AleFlow {
     };
     try {
       substeps(plan.substeps);
-      State& s = state_;
       if (plan.richardson) {
         const State fine = state_;
         restore(s0);
         substeps(plan.substeps / 2);
-        for (std::size_t i = 0; i < s.X[0].size(); ++i) s.X[0][i] = 2 * fine.X[0][i] - s.X[0][i];
-        s.U[0] = 2 * fine.U[0] - s.U[0];
-        for (std::size_t k = 0; k < s.bodies.size(); ++k) {
-          auto& b = s.bodies[k];
-          const auto& f = fine.bodies[k];
-          b.centre[0] = 2 * f.centre[0] - b.centre[0];
-          b.velocity[0] = 2 * f.velocity[0] - b.velocity[0];
-          b.orientation[0] = BodyModel::extrapolate(f.orientation[0], b.orientation[0]);
-          b.load = f.load, b.contact = f.contact;
-          bodies_.place_surface(b, k, 0, s.X[0]);
-        }
+        richardson(state_, fine);
+        for (std::size_t k = 0; k < state_.bodies.size(); ++k) bodies_.place_surface(state_.bodies[k], k, 0, state_.X[0]);
       }
-      // the history at t^n and t^n + dt (level 2 is not read with one level; it holds t^n too)
-      for (int k = 1; k < 3; ++k) s.X[k] = s0.X[0], s.U[k] = s0.U[0];
-      for (std::size_t i = 0; i < s.bodies.size(); ++i)
-        for (int k = 1; k < 3; ++k) {
-          s.bodies[i].centre[k] = s0.bodies[i].centre[0];
-          s.bodies[i].orientation[k] = s0.bodies[i].orientation[0];
-          s.bodies[i].velocity[k] = s0.bodies[i].velocity[0];
-        }
-      const auto& past = s0.time.steps();
-      s.time.assign(s0.time.now() + dt, 1, {dt, past[0], past[1]});
-      mesh_.set_coordinates(s.X[0]);
+      start_history(state_, s0, dt);
+      mesh_.set_coordinates(state_.X[0]);
       start_mesh_velocity();
     } catch (...) {
       restore(s0);

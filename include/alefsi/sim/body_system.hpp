@@ -202,16 +202,6 @@ class BodySystem {
     }
   }
 
-  /// The first step after a (re)start of a scheme reading level n-1: x^{n-1} = x^n - dt V^n,
-  /// the orientation stepped back, Z^{n-1} = Z^n.
-  void backfill(std::vector<State>& states, Real dt) const {
-    for (auto& s : states) {
-      s.centre[1] = s.centre[0] - dt * s.velocity[0].template head<D>();
-      s.orientation[1] = M::step_back(s.orientation[0], s.velocity[0], dt);
-      s.velocity[1] = s.velocity[0];
-    }
-  }
-
   /// Centre and orientation at t^{n+1} by the scheme's position formula with the predicted
   /// velocity; the surface nodes of `Xn1` by the exact rigid map.
   void advance(const std::vector<State>& states, const StepCoefficients& c, std::vector<Vec<D>>& Xn1) {

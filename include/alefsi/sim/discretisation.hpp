@@ -31,6 +31,8 @@
 #include "alefsi/physics/navier_stokes.hpp"
 #include "alefsi/sim/config.hpp"
 #include "alefsi/sim/newton.hpp"
+#include "alefsi/time/history.hpp"
+#include "alefsi/time/stepper.hpp"
 
 namespace alefsi {
 
@@ -91,6 +93,24 @@ class Discretisation {
   }
   bool constrained() const { return cons_ != nullptr; }
 
+  /// The kernel's inputs for the step with coefficients c: the BDF history of the time
+  /// derivative sum_{k>=1} a_k U^{n+1-k}, the extrapolated (convecting) velocity u*, U^n, the
+  /// mesh velocity the flow sees (per node) and the body force. `U` and `Vflow` are read
+  /// during the step's assembly: they must live until it is done.
+  void set_step(const StepCoefficients& c, const Levels<VecX>& U, const std::vector<Vec<D>>& Vflow,
+                VectorFunction<D> force) {
+    hist_ = VecX::Zero(U[0].size());
+    ustar_ = VecX::Zero(U[0].size());
+    for (int k = 1; k <= c.flow_order; ++k) hist_ += c.flow_bdf[k] * U[k - 1];
+    for (int k = 0; k < 3; ++k)
+      if (c.convection[k] != 0) ustar_ += c.convection[k] * U[k];
+    StepInputs<D> in;
+    in.dt = c.dt, in.theta = c.theta, in.a0 = c.flow_bdf[0];
+    in.history = &hist_, in.previous = &U[0], in.extrapolated = &ustar_, in.mesh_velocity = &Vflow;
+    in.force = std::move(force);
+    kernel_->set_step(in);
+  }
+
   /// Gives a block-aware solver the blocks for a velocity block holding gamma M_u (gamma =
   /// rho a_0 / (theta dt)); nothing for other solvers.
   void prepare_solver(Real gamma) {
@@ -126,6 +146,7 @@ class Discretisation {
   std::vector<std::pair<Index, int>> dirichlet_dofs_;
   bool pinned_ = false;
   Real gamma_ = -1;
+  VecX hist_, ustar_;  // the step's kernel inputs
 };
 
 }  // namespace alefsi

@@ -16,7 +16,9 @@
 ///             not written)
 ///   remesh    what the remesh trigger remembers of the last remesh
 ///
-/// `write_state` / `read_state` put it in / take it from a checkpoint (sim/checkpoint.hpp).
+/// `write_state` / `read_state` put it in / take it from a checkpoint (sim/checkpoint.hpp);
+/// `backfill`, `richardson` and `start_history` are the state algebra of the start-up
+/// procedures (time/stepper.hpp).
 #include <array>
 #include <cstdint>
 #include <string>
@@ -59,6 +61,54 @@ struct FlowState {
   FlowStats stats;
   RemeshMemory remesh;
 };
+
+/// The first step after a (re)start of a scheme that reads level n-1: X^{n-1} = X^n - dt V^n,
+/// U^{n-1} = U^n, each body's centre x^n - dt V^n, orientation stepped back, Z^{n-1} = Z^n.
+template <int D, RigidBodyModel M>
+void backfill(FlowState<D, M>& s, Real dt) {
+  s.X[1] = s.X[0];
+  for (std::size_t i = 0; i < s.X[1].size(); ++i) s.X[1][i] -= dt * s.V[i];
+  s.U[1] = s.U[0];
+  for (auto& b : s.bodies) {
+    b.centre[1] = b.centre[0] - dt * b.velocity[0].template head<D>();
+    b.orientation[1] = M::step_back(b.orientation[0], b.velocity[0], dt);
+    b.velocity[1] = b.velocity[0];
+  }
+}
+
+/// Richardson extrapolation of level n: `coarse` (error ~2e) := 2 fine - coarse (positions,
+/// field, bodies' centre and velocity; the orientation by M::extrapolate), the last step's
+/// loads and contact forces from `fine`. The bodies' surface nodes of X^n are left to the
+/// caller (their exact rigid map at the extrapolated place).
+template <int D, RigidBodyModel M>
+void richardson(FlowState<D, M>& coarse, const FlowState<D, M>& fine) {
+  for (std::size_t i = 0; i < coarse.X[0].size(); ++i) coarse.X[0][i] = 2 * fine.X[0][i] - coarse.X[0][i];
+  coarse.U[0] = 2 * fine.U[0] - coarse.U[0];
+  for (std::size_t k = 0; k < coarse.bodies.size(); ++k) {
+    auto& b = coarse.bodies[k];
+    const auto& f = fine.bodies[k];
+    b.centre[0] = 2 * f.centre[0] - b.centre[0];
+    b.velocity[0] = 2 * f.velocity[0] - b.velocity[0];
+    b.orientation[0] = M::extrapolate(f.orientation[0], b.orientation[0]);
+    b.load = f.load, b.contact = f.contact;
+  }
+}
+
+/// After a start-up procedure took `s` from `s0` (at t^n) to t^n + dt by other means (substeps):
+/// the history is t^n + dt with one past level, s0's level 0 (level 2 is not read with one
+/// level; it holds the same).
+template <int D, RigidBodyModel M>
+void start_history(FlowState<D, M>& s, const FlowState<D, M>& s0, Real dt) {
+  for (int k = 1; k < 3; ++k) s.X[k] = s0.X[0], s.U[k] = s0.U[0];
+  for (std::size_t i = 0; i < s.bodies.size(); ++i)
+    for (int k = 1; k < 3; ++k) {
+      s.bodies[i].centre[k] = s0.bodies[i].centre[0];
+      s.bodies[i].orientation[k] = s0.bodies[i].orientation[0];
+      s.bodies[i].velocity[k] = s0.bodies[i].velocity[0];
+    }
+  const auto& past = s0.time.steps();
+  s.time.assign(s0.time.now() + dt, 1, {dt, past[0], past[1]});
+}
 
 namespace detail {
 template <int D>

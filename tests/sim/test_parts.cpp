@@ -33,6 +33,7 @@ struct PartialModel {
   using Velocity = T::Velocity;
   using Orientation = T::Orientation;
   static constexpr int dim = 2, n_dof = 3;
+  static constexpr const char* name = "partial";
   static constexpr auto orientation_columns = T::orientation_columns;
   static constexpr auto velocity_columns = T::velocity_columns;
   static constexpr auto load_columns = T::load_columns;

@@ -359,6 +359,7 @@ struct RigidBodyAccessors {
 
 template <>
 struct RigidBodyTraits<2> : RigidBodyAccessors<RigidBody2D, Vec<3>> {
+  static constexpr const char* name = "rigid body 2D (3 DOF)";
   using Body = RigidBody2D;
   static constexpr int dim = 2;
   static constexpr int n_dof = 3;
@@ -402,6 +403,7 @@ struct RigidBodyTraits<2> : RigidBodyAccessors<RigidBody2D, Vec<3>> {
 
 template <>
 struct RigidBodyTraits<3> : RigidBodyAccessors<RigidBody3D, Vec<6>> {
+  static constexpr const char* name = "rigid body 3D (6 DOF)";
   using Body = RigidBody3D;
   static constexpr int dim = 3;
   static constexpr int n_dof = 6;
@@ -486,6 +488,7 @@ concept RigidBodyModel = requires(const typename T::Body& body, const typename T
                                   const Vec<T::dim>& r, const std::array<Real, 4>& bdf, Real dt, int l, std::size_t index) {
   requires T::dim == 2 || T::dim == 3;
   requires T::n_dof == T::dim * (T::dim + 1) / 2;
+  { T::name } -> std::convertible_to<const char*>;  // checkpoints record it
   requires std::tuple_size_v<decltype(T::velocity_columns)> == std::size_t(T::n_dof);
   requires std::tuple_size_v<decltype(T::load_columns)> == std::size_t(T::n_dof);
   // the body's properties

@@ -238,40 +238,59 @@ class AleFlow {
   }
 
   // ---- checkpoints ---------------------------------------------------------------------------
-  /// Writes the whole state at t^n (mesh and flow state) to `file`, atomically. A flow built on
+  /// Writes the whole state at t^n (configuration, mesh, flow state) to `file`, atomically;
+  /// the checkpoint it replaces is kept as `<file>.prev` (sim/checkpoint.hpp). A flow built on
   /// `read_checkpoint_mesh<D>(file)`, given the same configuration (options, boundary data,
   /// bodies, remeshing, contacts) and then `load_checkpoint(file)`, continues bit for bit.
   void save_checkpoint(const std::filesystem::path& file) const {
     CheckpointWriter w(file);
-    w.section("config");
-    w.put(std::int32_t(D));
-    w.put_string(Cfg::Pair::name);
-    w.put_string(Scheme::name);
+    write_config(w);
     write_mesh(w, mesh_);
     write_state(w, state_, bodies_.tags());
-    w.section("end");
-    w.commit();
+    w.commit(true);
   }
   /// Restores what `save_checkpoint` wrote into a flow that has not stepped yet and was built
-  /// on the checkpoint's mesh with the same configuration.
+  /// on the checkpoint's mesh with the same configuration; a file written by another
+  /// configuration, or not exactly as written, is refused (IoError naming the file and what
+  /// differs) and the flow is left as it was.
   void load_checkpoint(const std::filesystem::path& file) {
     require_not_started("load_checkpoint");
     CheckpointReader r(file);
-    r.section("config");
-    if (r.get<std::int32_t>("dimension") != D) r.fail("written by a flow of another dimension");
-    if (r.get_string("element pair") != Cfg::Pair::name) r.fail("written with another element pair");
-    if (r.get_string("scheme") != Scheme::name) r.fail("written with another time scheme");
+    check_config(r);
     const Mesh<D> m = read_mesh<D>(r);
     if (m.n_nodes() != mesh_.n_nodes() || m.cells() != mesh_.cells() || m.coordinates() != mesh_.coordinates())
       r.fail("the flow's mesh is not the checkpoint's (build it with read_checkpoint_mesh)");
-    read_state(r, state_, bodies_.tags(), space().n_field());
-    state_.X[0] = mesh_.coordinates();
-    r.section("end");
+    State s = state_;
+    read_state(r, s, bodies_.tags(), space().n_field());
     r.finish();
+    s.X[0] = mesh_.coordinates();
+    state_ = std::move(s);
     setup();
   }
 
  private:
+  // The configuration a checkpoint was written with, checked on reading (what differs named).
+  void write_config(CheckpointWriter& w) const {
+    w.section("config");
+    w.put(std::int32_t(D));
+    for (const char* n : {Cfg::Pair::name, Scheme::name, Cfg::Equations::name, BodyModel::name}) w.put_string(n);
+    w.put_vector(bodies_.tags());
+  }
+  void check_config(CheckpointReader& r) const {
+    r.section("config");
+    if (const int d = r.get<std::int32_t>("dimension"); d != D)
+      r.fail("written by a " + std::to_string(d) + "D flow, this flow is " + std::to_string(D) + "D");
+    const char* what[] = {"element pair", "time scheme", "equations", "rigid-body model"};
+    const char* mine[] = {Cfg::Pair::name, Scheme::name, Cfg::Equations::name, BodyModel::name};
+    for (int i = 0; i < 4; ++i)
+      if (const std::string got = r.get_string(what[i]); got != mine[i])
+        r.fail(std::string("written with the ") + what[i] + " '" + got + "', this flow has '" + mine[i] + "'");
+    const auto tags = r.get_vector<int>("body tags");
+    if (tags.size() != bodies_.size())
+      r.fail("written with " + std::to_string(tags.size()) + " bodies, this flow has " + std::to_string(bodies_.size()));
+    if (tags != bodies_.tags()) r.fail("the bodies' tags differ from this flow's");
+  }
+
   void require_not_started(const char* what) const {
     if (disc_.constrained()) throw Error(std::string("AleFlow::") + what + " after the first step");
   }
@@ -429,9 +448,10 @@ template <int D>
 Mesh<D> read_checkpoint_mesh(const std::filesystem::path& file) {
   CheckpointReader r(file);
   r.section("config");
-  if (r.get<std::int32_t>("dimension") != D) r.fail("written by a flow of another dimension");
-  r.get_string("element pair");
-  r.get_string("scheme");
+  if (const int d = r.get<std::int32_t>("dimension"); d != D)
+    r.fail("written by a " + std::to_string(d) + "D flow, not a " + std::to_string(D) + "D one");
+  for (const char* what : {"element pair", "time scheme", "equations", "rigid-body model"}) r.get_string(what);
+  r.get_vector<int>("body tags");
   return read_mesh<D>(r);
 }
 

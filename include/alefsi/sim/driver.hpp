@@ -9,9 +9,15 @@
 ///    MeshError (a cell would invert), the flow is still at t^n (AleFlow guarantees it), so
 ///    the step is retried with dt / 2, up to `max_retries` halvings; after `recover_after`
 ///    good steps the driver tries twice the dt again, up to the nominal one. Each change of dt
-///    restarts the multistep history (AleFlow). If the retries run out, `run` throws Error
-///    naming t, dt and the last failure; what was written until then stays valid.
-///  * the last step is shortened to land on t_end exactly (within 1e-12 dt).
+///    restarts the multistep history (AleFlow). If the retries run out, `run` writes a
+///    checkpoint of the last good state (when checkpoints are on) and throws Error naming t,
+///    dt and the last failure; what was written until then stays valid.
+///  * the end: the flow counts its time (t = t_a + k dt, time/history.hpp), so a t_end on the
+///    step grid is reached by steps of dt exactly, the last one included (no sliver, no
+///    start-up step at the end). Off the grid, a remainder of up to `absorb` dt is taken into
+///    the last step (one step of up to (1 + absorb) dt), a larger one is a last, shorter step.
+///    A run to T1 continued from its final checkpoint to T2 is then bit for bit the run to T2
+///    (for T1 on the grid, and no step being retried at T1).
 ///  * output (when `output` is set): `<output>/bodies.csv` (one row per step: t, dt, Newton
 ///    iterations, remeshed, worst quality, then per body k: the centre (x, y[, z]), the
 ///    orientation (2D: angle; 3D: quaternion qw, qx, qy, qz), the velocity Z (2D: vx, vy,
@@ -19,8 +25,8 @@
 ///    fy, fz, tx, ty, tz), the contact force (fcx, fcy[, fcz]) and the gap; the column names
 ///    are the rigid-body model's), `<output>/flow.pvd` + steps every
 ///    `vtu_every` steps (velocity, pressure, mesh velocity on the P1 nodes),
-///    `<output>/checkpoint.bin` every `checkpoint_every` steps (atomic; see
-///    AleFlow::save_checkpoint). A restarted run (flow.time() > 0) appends to bodies.csv after
+///    `<output>/checkpoint.bin` every `checkpoint_every` steps and at the end (atomic, the
+///    previous one kept as checkpoint.bin.prev; see AleFlow::save_checkpoint). A restarted run (flow.time() > 0) appends to bodies.csv after
 ///    dropping rows later than the restart time, and starts a new PVD series
 ///    `flow_from_<step>.pvd`.
 ///  * a progress line every `progress_every` steps (and at the end) on `log`.
@@ -42,6 +48,7 @@
 
 #include "alefsi/core/error.hpp"
 #include "alefsi/mesh/io/vtu.hpp"
+#include "alefsi/sim/newton.hpp"
 
 namespace alefsi {
 
@@ -54,6 +61,7 @@ struct RunOptions {
   int progress_every = 10;          ///< 0: no progress lines
   int max_retries = 6;              ///< dt halvings allowed for one step
   int recover_after = 20;           ///< good steps before trying a larger dt again
+  Real absorb = 0.1;                ///< a remainder up to absorb * dt joins the last step; in [0, 1)
   std::ostream* log = &std::cout;   ///< progress and remarks; nullptr: silent
   /// Called after every accepted step (e.g. extra monitoring); may throw to stop the run.
   std::function<void()> on_step = {};
@@ -66,6 +74,7 @@ struct RunOptions {
     ALEFSI_CHECK_ARG(progress_every >= 0, "progress_every", "must be >= 0, got ", progress_every);
     ALEFSI_CHECK_ARG(max_retries >= 0, "max_retries", "must be >= 0, got ", max_retries);
     ALEFSI_CHECK_ARG(recover_after >= 1, "recover_after", "must be >= 1, got ", recover_after);
+    ALEFSI_CHECK_ARG(absorb >= 0 && absorb < 1, "absorb", "must be in [0, 1), got ", absorb);
   }
 };
 
@@ -186,20 +195,27 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
 
   Real dt = opt.dt;
   int good = 0;
-  auto log = [&](const std::string& s) {
-    if (opt.log) *opt.log << s << std::endl;
+  auto log = [&](const std::string& text) {
+    if (opt.log) *opt.log << text << std::endl;
   };
-  while (flow.time() < opt.t_end - 1e-12 * opt.dt) {
-    const Real h = std::min(dt, opt.t_end - flow.time());
+  const bool checkpoints = !opt.output.empty() && opt.checkpoint_every > 0;
+  const auto checkpoint = opt.output / "checkpoint.bin";
+  // the end is reached when what is left is round-off of the step grid
+  auto left = [&] { return opt.t_end - flow.time(); };
+  while (left() > 1e-9 * opt.dt) {
+    Real h = dt;
+    if (std::abs(left() - dt) > 1e-9 * dt && left() < (1 + opt.absorb) * dt) h = left();
     decltype(flow.step(Real(1))) rep{};
     int tries = 0;
     Real h_try = h;
     for (;;) {
       auto reject = [&](const Error& e) {
-        if (++tries > opt.max_retries)
-          throw Error("step at t = " + std::to_string(flow.time()) + " failed with dt = " + std::to_string(h_try) +
-                      " after " + std::to_string(opt.max_retries) + " retries: " + e.what());
-        log("  rejected step at t = " + std::to_string(flow.time()) + " (dt " + std::to_string(h_try) + "): " + e.what());
+        if (++tries > opt.max_retries) {
+          if (checkpoints) flow.save_checkpoint(checkpoint);  // the last good state
+          throw Error("step at t = " + detail::sci(flow.time()) + " failed with dt = " + detail::sci(h_try) + " after " +
+                      std::to_string(opt.max_retries) + " retries: " + e.what());
+        }
+        log("  rejected step at t = " + detail::sci(flow.time()) + " (dt " + detail::sci(h_try) + "): " + e.what());
       };
       try {
         rep = flow.step(h_try);
@@ -230,11 +246,10 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
       csv << '\n' << std::flush;
     }
     const int n = flow.stats().steps;
+    const bool last = left() <= 1e-9 * opt.dt;
     if (pvd && n % opt.vtu_every == 0) write_vtu_now();
-    if (!opt.output.empty() && opt.checkpoint_every > 0 && n % opt.checkpoint_every == 0)
-      flow.save_checkpoint(opt.output / "checkpoint.bin");
+    if (checkpoints && (n % opt.checkpoint_every == 0 || last)) flow.save_checkpoint(checkpoint);
     if (opt.on_step) opt.on_step();
-    const bool last = flow.time() >= opt.t_end - 1e-12 * opt.dt;
     if (opt.progress_every > 0 && (n % opt.progress_every == 0 || last)) {
       const Real el = wall(), frac = (flow.time() - t_start) / (opt.t_end - t_start);
       std::ostringstream s;

@@ -20,6 +20,7 @@
 /// `backfill`, `richardson` and `start_history` are the state algebra of the start-up
 /// procedures (time/stepper.hpp).
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -149,6 +150,8 @@ void write_state(CheckpointWriter& w, const FlowState<D, M>& s, const std::vecto
   w.put(s.time.now());
   for (Real dt : s.time.steps()) w.put(dt);
   w.put(std::int32_t(s.time.levels()));
+  const auto count = s.time.count();
+  w.put(count.anchor), w.put(count.dt), w.put(count.steps);
   w.put(std::int32_t(s.stats.steps));
   w.put(std::int32_t(s.stats.remeshes));
   w.put(std::int32_t(s.stats.history_restarts));
@@ -184,7 +187,13 @@ void read_state(CheckpointReader& r, FlowState<D, M>& s, const std::vector<int>&
   for (Real& dt : steps) dt = r.get<Real>("step size");
   const int levels = r.get<std::int32_t>("levels");
   if (levels < 0) r.fail("negative number of history levels");
+  if (!std::isfinite(t)) r.fail("non-finite time");
   s.time.assign(t, levels, steps);
+  TimeHistory::Count count;
+  count.anchor = r.get<Real>("time counter"), count.dt = r.get<Real>("time counter");
+  count.steps = r.get<std::int64_t>("time counter");
+  if (!std::isfinite(count.anchor) || !std::isfinite(count.dt) || count.steps < 0) r.fail("invalid time counter");
+  s.time.set_count(count);
   s.stats.steps = r.get<std::int32_t>("steps");
   s.stats.remeshes = r.get<std::int32_t>("remeshes");
   s.stats.history_restarts = r.get<std::int32_t>("history restarts");

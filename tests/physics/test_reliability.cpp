@@ -1,0 +1,179 @@
+// Reliability of runs (issue 18): runs that end where they should, runs that can be continued
+// exactly, checkpoints that refuse to be wrong, Newton at any dt.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "alefsi/mesh/generate/structured.hpp"
+#include "alefsi/scenes/annulus.hpp"
+#include "alefsi/scenes/settling.hpp"
+#include "alefsi/sim/ale_flow.hpp"
+#include "alefsi/sim/driver.hpp"
+
+using namespace alefsi;
+namespace fs = std::filesystem;
+
+namespace {
+struct TempDir {
+  fs::path path;
+  explicit TempDir(const std::string& name) : path(fs::temp_directory_path() / name) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+using Annulus = AleFlow<FlowConfig<2, TaylorHood, BDF2_BDF2E>>;
+std::unique_ptr<Annulus> annulus_flow(Mesh<2> mesh) {
+  auto flow = std::make_unique<Annulus>(std::move(mesh), FlowOptions{.rho = 1, .mu = 1});
+  scenes::Annulus{}.configure(*flow);
+  return flow;
+}
+RunOptions quiet(Real dt, Real t_end) {
+  RunOptions ro;
+  ro.dt = dt, ro.t_end = t_end, ro.progress_every = 0, ro.log = nullptr;
+  return ro;
+}
+}  // namespace
+
+TEST_CASE("time is counted, not summed: t_end on the step grid is reached by steps of dt, none a start-up step",
+          "[reliability][quick]") {
+  TimeHistory h;
+  for (int n = 0; n < 1800; ++n) h.advance(5e-4);
+  CHECK(h.now() == 0.9);  // summing 5e-4 1800 times gives 0.8999999999999563
+  // the annulus to t = 0.3 in steps of 0.01 (summed: 0.30000000000000010, and the last step a
+  // sliver of 1e-16 that restarted the history)
+  auto flow = annulus_flow(annulus_mesh(0.25, 1.0, 2, 16));
+  const RunSummary s = run(*flow, quiet(0.01, 0.3));
+  CHECK(flow->time() == 0.3);
+  CHECK(s.steps == 30);
+  CHECK(flow->stats().history_restarts == 0);
+  // off the grid: a remainder below absorb * dt joins the last step, a larger one is a shorter step
+  auto off = annulus_flow(annulus_mesh(0.25, 1.0, 2, 16));
+  CHECK(run(*off, quiet(0.01, 0.1005)).steps == 10);
+  CHECK(off->time() == Approx(0.1005).epsilon(1e-15));
+  CHECK(run(*off, quiet(0.01, 0.1205)).steps == 2);
+}
+
+TEST_CASE("Newton stops at any dt: a step of 1e-13 s converges by the scaled residual", "[reliability][quick]") {
+  auto flow = annulus_flow(annulus_mesh(0.25, 1.0, 2, 16));
+  for (int n = 0; n < 3; ++n) flow->step(0.01);
+  // the residual stalls at eps rho/dt |u| ~ 1e-5 here, against a first residual of 0.4 (before the
+  // scaled test: "Newton did not converge in 25 iterations (residual 9.6e-06, first 4.0e-01)")
+  const StepReport rep = flow->step(1e-13);
+  CHECK(rep.newton_iterations <= 3);
+  CHECK(flow->time() == Approx(0.03).margin(1e-12));
+}
+
+TEST_CASE("a run to T1 continued from its final checkpoint to T2 is the run to T2, bit for bit, across remeshes",
+          "[reliability][checkpoint][quick]") {
+  using Dkt = AleFlow<FlowConfig<2, P1P1Gls, BDF2_BDF2E>>;
+  const auto scene = scenes::SettlingDisks::dkt(0.01);
+  const Real hb = 0.03, hf = 0.3, dt = 2e-3;
+  auto make = [&](Mesh<2> mesh) {
+    auto flow = std::make_unique<Dkt>(std::move(mesh), FlowOptions{.rho = 1, .mu = 0.01,
+                                                                  .linearisation = Linearisation::semi_implicit});
+    scene.configure(*flow, hb, hf);
+    return flow;
+  };
+  TempDir dir("alefsi_test_continue");
+  // meshed twice as coarse as the size function wants: the first steps remesh
+  auto straight = make(scene.mesh(2 * hb, hf));
+  run(*straight, quiet(dt, 0.06));
+  REQUIRE(straight->stats().remeshes > 0);
+
+  RunOptions first = quiet(dt, 0.03);
+  first.output = dir.path, first.checkpoint_every = 1000;  // no periodic checkpoint: only the one at the end
+  auto part = make(scene.mesh(2 * hb, hf));
+  run(*part, first);
+  REQUIRE(fs::exists(dir.path / "checkpoint.bin"));
+  auto continued = make(read_checkpoint_mesh<2>(dir.path / "checkpoint.bin"));
+  continued->load_checkpoint(dir.path / "checkpoint.bin");
+  CHECK(continued->time() == 0.03);
+  RunOptions second = first;
+  second.t_end = 0.06;
+  run(*continued, second);
+  CHECK(continued->time() == straight->time());
+  CHECK(continued->stats().history_restarts == straight->stats().history_restarts);
+  REQUIRE(continued->mesh().n_nodes() == straight->mesh().n_nodes());
+  CHECK(continued->mesh().coordinates() == straight->mesh().coordinates());
+  CHECK(continued->field() == straight->field());
+  for (std::size_t b = 0; b < 2; ++b) {
+    CHECK(continued->body_centre(b) == straight->body_centre(b));
+    CHECK(continued->body_velocity(b) == straight->body_velocity(b));
+  }
+  // the CSV holds each step once
+  std::ifstream csv(dir.path / "bodies.csv");
+  int rows = -1;
+  for (std::string line; std::getline(csv, line);) ++rows;
+  CHECK(rows == 30);
+}
+
+TEST_CASE("a checkpoint that is not exactly what was written, or was written by another flow, is refused",
+          "[reliability][checkpoint][quick]") {
+  TempDir dir("alefsi_test_corrupt");
+  const fs::path file = dir.path / "checkpoint.bin";
+  auto flow = annulus_flow(annulus_mesh(0.25, 1.0, 2, 16));
+  for (int n = 0; n < 3; ++n) flow->step(0.01);
+  flow->save_checkpoint(file);
+  flow->step(0.01);
+  flow->save_checkpoint(file);  // the first one is kept as checkpoint.bin.prev
+  REQUIRE(fs::exists(CheckpointWriter::previous_path(file)));
+  const auto size = fs::file_size(file);
+  REQUIRE(size > 2000);
+  auto load = [&](const fs::path& f) {
+    auto fresh = annulus_flow(read_checkpoint_mesh<2>(f));
+    fresh->load_checkpoint(f);
+    return fresh->time();
+  };
+  CHECK(load(file) == Approx(0.04));
+  CHECK(load(CheckpointWriter::previous_path(file)) == Approx(0.03));
+  auto corrupt = [&](std::size_t at, const void* bytes, std::size_t n) {
+    const fs::path f = dir.path / ("corrupt_" + std::to_string(at) + ".bin");
+    fs::copy_file(file, f, fs::copy_options::overwrite_existing);
+    std::fstream io(f, std::ios::in | std::ios::out | std::ios::binary);
+    io.seekp(std::streamoff(at));
+    io.write(static_cast<const char*>(bytes), std::streamsize(n));
+    return f;
+  };
+  // four bytes inside the mesh section, and a double set to +inf in the state section
+  const std::uint32_t junk = 0xDEADBEEF;
+  const Real inf = std::numeric_limits<Real>::infinity();
+  for (const fs::path& f : {corrupt(200, &junk, 4), corrupt(size - 1000, &inf, 8)}) {
+    CHECK_THROWS_AS(load(f), IoError);
+    auto other = annulus_flow(annulus_mesh(0.25, 1.0, 2, 16));
+    CHECK_THROWS_WITH(other->load_checkpoint(f), Catch::Contains(f.string()) && Catch::Contains("checksum"));
+  }
+  // truncated
+  const fs::path cut = dir.path / "cut.bin";
+  fs::copy_file(file, cut);
+  fs::resize_file(cut, size / 2);
+  CHECK_THROWS_WITH(read_checkpoint_mesh<2>(cut), Catch::Contains("truncated"));
+  // another configuration: scheme, pair, number of bodies; the flow is left as it was
+  {
+    AleFlow<FlowConfig<2, TaylorHood, BDF3_BDF3E>> bdf3(read_checkpoint_mesh<2>(file), FlowOptions{});
+    scenes::Annulus{}.configure(bdf3);
+    CHECK_THROWS_WITH(bdf3.load_checkpoint(file), Catch::Contains("time scheme 'BDF2/BDF2E'") &&
+                                                       Catch::Contains("'BDF3/BDF3E'"));
+    CHECK(bdf3.time() == 0);
+  }
+  {
+    AleFlow<FlowConfig<2, P1P1Gls, BDF2_BDF2E>> gls(read_checkpoint_mesh<2>(file), FlowOptions{});
+    scenes::Annulus{}.configure(gls);
+    CHECK_THROWS_WITH(gls.load_checkpoint(file), Catch::Contains("element pair"));
+  }
+  {
+    Annulus no_body(read_checkpoint_mesh<2>(file), FlowOptions{.rho = 1, .mu = 1});
+    no_body.set_velocity(tags::outer, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });
+    no_body.set_velocity(tags::inner, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });
+    CHECK_THROWS_WITH(no_body.load_checkpoint(file), Catch::Contains("1 bodies, this flow has 0"));
+    CHECK(no_body.time() == 0);
+  }
+  CHECK_THROWS_WITH(read_checkpoint_mesh<3>(file), Catch::Contains("2D flow"));
+}

@@ -15,6 +15,7 @@
 #include "alefsi/mesh/generate/mesher2d.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
 #include "alefsi/reference/annulus.hpp"
+#include "alefsi/scenes/annulus.hpp"
 #include "alefsi/sim/ale_flow.hpp"
 
 using namespace alefsi;
@@ -143,8 +144,10 @@ namespace {
 struct Fig7Case {
   Real r1 = 0.25, r2 = 1.0, rho_s = 1.25, ramp = 0;
   Real omega2(Real t) const { return ramp > 0 ? 1 - std::exp(-std::pow(t / ramp, 4)) : 1.0; }
-  Real mass() const { return rho_s * pi * r1 * r1; }
-  Real inertia() const { return 0.5 * mass() * r1 * r1; }
+  scenes::Annulus scene() const {
+    return {.r1 = r1, .r2 = r2, .rho_s = rho_s, .omega = [c = *this](Real t) { return c.omega2(t); }};
+  }
+  Real inertia() const { return scene().inner_body().inertia; }
   AnnulusProblem fd() const {
     AnnulusProblem p;
     p.r1 = r1, p.r2 = r2, p.rho = 1, p.mu = 1, p.inertia = inertia();
@@ -155,12 +158,7 @@ struct Fig7Case {
   template <class Scheme>
   std::vector<Real> fem_omega(const Mesh<2>& mesh, Real dt, int steps, VecX* field = nullptr) const {
     AleFlow<FlowConfig<2, TaylorHood, Scheme>> flow(mesh, FlowOptions{1.0, 1.0});
-    flow.set_velocity(tags::outer, [c = *this](const Vec<2>& x, Real t) { return Vec<2>(c.omega2(t) * Vec<2>(-x[1], x[0])); });
-    RigidBody2D body;
-    body.tag = tags::inner;
-    body.mass = mass();
-    body.inertia = inertia();
-    flow.add_body(body);
+    scene().configure(flow);
     std::vector<Real> w;
     for (int n = 0; n < steps; ++n) {
       flow.step(dt);
@@ -293,15 +291,9 @@ template <class Scheme>
 Real spun_body(Real dt, int damped, Real T = 0.1) {
   const Real r1 = 0.25, r2 = 1.0;
   AleFlow<FlowConfig<2, TaylorHood, Scheme>> flow(annulus_mesh(r1, r2, 3, 32),
-                                      FlowOptions{1.0, 1.0, Linearisation::semi_implicit, 25, 1e-10, damped});
-  flow.set_velocity(tags::outer, [](const Vec<2>& x, Real) { return Vec<2>(-x[1], x[0]); });
-  RigidBody2D body;
-  body.tag = tags::inner;
-  body.mass = 1.25 * pi * r1 * r1;
-  body.inertia = 0.5 * body.mass * r1 * r1;
-  body.velocity = Vec<3>(0, 0, 1);
-  body.external_load = Vec<3>(0, 0, 0.3);
-  flow.add_body(body);
+                                                  FlowOptions{1.0, 1.0, Linearisation::semi_implicit, 25, 1e-10, damped});
+  const scenes::Annulus scene{.r1 = r1, .initial_velocity = Vec<3>(0, 0, 1), .external_load = Vec<3>(0, 0, 0.3)};
+  scene.configure(flow);
   flow.set_initial_velocity([](const Vec<2>& x) { return Vec<2>(-x[1], x[0]); });
   const int n = int(std::lround(T / dt));
   for (int i = 0; i < n; ++i) flow.step(dt);
@@ -332,21 +324,10 @@ namespace {
 // consistent initial field, with a jump inside the first cell layer). The field at T.
 template <class Scheme>
 VecX impulsive_field(const Mesh<2>& mesh, Real dt, int damped, Real T) {
-  const Real r1 = 0.25;
   AleFlow<FlowConfig<2, TaylorHood, Scheme>> flow(mesh, FlowOptions{1.0, 1.0, Linearisation::semi_implicit, 25, 1e-10, damped});
-  flow.set_velocity(tags::outer, [](const Vec<2>& x, Real) { return Vec<2>(-x[1], x[0]); });
-  RigidBody2D body;
-  body.tag = tags::inner;
-  body.mass = 1.25 * pi * r1 * r1;
-  body.inertia = 0.5 * body.mass * r1 * r1;
-  flow.add_body(body);
-  std::vector<Vec<2>> wall;
-  for (Index i : flow.space().velocity().boundary_dofs(tags::outer)) wall.push_back(flow.space().velocity().point(i));
-  flow.set_initial_velocity([&](const Vec<2>& x) {
-    for (const auto& y : wall)
-      if ((x - y).norm() < 1e-12) return Vec<2>(-x[1], x[0]);
-    return Vec<2>(Vec<2>::Zero());
-  });
+  const scenes::Annulus scene;
+  scene.configure(flow);
+  scene.start_with_moving_wall(flow);
   const int n = int(std::lround(T / dt));
   for (int i = 0; i < n; ++i) flow.step(dt);
   return flow.field();
@@ -389,15 +370,7 @@ TEST_CASE("damped start: checkpoint + restart continues bit for bit, across a da
   // the dt change after the checkpoint restarts the history, with a damped start again.
   using Flow = AleFlow<FlowConfig<2, TaylorHood, BDF3_BDF3E>>;
   const FlowOptions opt{1.0, 1.0, Linearisation::newton, 25, 1e-10, 4};
-  auto configure = [](Flow& flow) {
-    flow.set_velocity(tags::outer, [](const Vec<2>& x, Real) { return Vec<2>(-x[1], x[0]); });
-    RigidBody2D body;
-    body.tag = tags::inner;
-    body.mass = 1.25 * pi * 0.25 * 0.25;
-    body.inertia = 0.5 * body.mass * 0.25 * 0.25;
-    body.external_load = Vec<3>(0, 0, 0.3);
-    flow.add_body(body);
-  };
+  auto configure = [](Flow& flow) { scenes::Annulus{.external_load = Vec<3>(0, 0, 0.3)}.configure(flow); };
   Flow straight(annulus_mesh(0.25, 1.0, 3, 32), opt);
   configure(straight);
   const auto dir = std::filesystem::temp_directory_path() / "alefsi_test_checkpoint_damped";

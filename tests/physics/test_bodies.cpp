@@ -9,6 +9,7 @@
 
 #include "alefsi/mesh/generate/mesher2d.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
+#include "alefsi/scenes/annulus.hpp"
 #include "alefsi/sim/ale_flow.hpp"
 
 using namespace alefsi;
@@ -80,12 +81,7 @@ TEMPLATE_TEST_CASE("extreme density ratios stay stable (annulus, outer wall turn
   const Real r1 = 0.25, r2 = 1.0;
   for (Real rho_s : {1e-6, 1e2}) {
     AleFlow<FlowConfig<2, P1P1Gls, TestType>> flow(annulus_mesh(r1, r2, 6, 64), FlowOptions{1.0, 1.0});
-    flow.set_velocity(tags::outer, [](const Vec<2>& x, Real) { return Vec<2>(-x[1], x[0]); });  // omega_2 = 1
-    RigidBody2D body;
-    body.tag = tags::inner;
-    body.mass = rho_s * pi * r1 * r1;
-    body.inertia = 0.5 * body.mass * r1 * r1;
-    flow.add_body(body);
+    scenes::Annulus{.r1 = r1, .r2 = r2, .rho_s = rho_s}.configure(flow);  // omega_2 = 1
     Real wmax = 0;
     for (int n = 0; n < 40; ++n) {
       flow.step(0.02);
@@ -110,15 +106,7 @@ TEMPLATE_TEST_CASE("free body spun up by the wall: angular velocity converges at
   auto omega_at_T = [&](Real dt) {
     AleFlow<FlowConfig<2, TaylorHood, TestType>> flow(annulus_mesh(r1, r2, 3, 32),
                                           FlowOptions{1.0, 1.0, Linearisation::semi_implicit});
-    flow.set_velocity(tags::outer, [](const Vec<2>& x, Real t) {
-      const Real w2 = 1 - std::exp(-std::pow(t / 0.1, 4));
-      return Vec<2>(-w2 * x[1], w2 * x[0]);
-    });
-    RigidBody2D body;
-    body.tag = tags::inner;
-    body.mass = 1.25 * pi * r1 * r1;
-    body.inertia = 0.5 * body.mass * r1 * r1;
-    flow.add_body(body);
+    scenes::Annulus{.r1 = r1, .r2 = r2, .omega = [](Real t) { return 1 - std::exp(-std::pow(t / 0.1, 4)); }}.configure(flow);
     const int n = int(std::lround(T / dt));
     for (int i = 0; i < n; ++i) flow.step(dt);
     return flow.body_velocity(0)[2];

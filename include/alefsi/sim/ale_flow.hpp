@@ -188,8 +188,10 @@ class AleFlow {
     for (Index v : bodies_.surface_nodes(k)) x.push_back(state_.X[0][v]);
     return x;
   }
-  /// Hydrodynamic force and torque on free body k over the last step ((F1, F2, T3) in 2D, (F, T)
-  /// in 3D, torque about the centre of mass, world axes), from its momentum balance.
+  /// Hydrodynamic force and torque on body k over the last step ((F1, F2, T3) in 2D, (F, T) in
+  /// 3D, torque about the centre of mass, world axes): a free body's from its momentum balance,
+  /// a driven body's from the residual of the rows it would have if it were free (the same
+  /// quantity; BodySystem::driven_loads).
   BodyVelocity body_hydrodynamic_load(std::size_t k) const { return state_.bodies.at(k).load; }
   /// Contact force on body k in the last step.
   Vec<D> body_collision_force(std::size_t k) const { return state_.bodies.at(k).contact; }
@@ -336,6 +338,7 @@ class AleFlow {
       // 4. the flow at n+theta
       const VecX u = solve_flow(c, t1, g, Xth, rep);
       VecX field = disc_.constraints().expand(u);
+      bodies_.driven_loads(s.bodies, space(), disc_.kernel(), field, c, Xth);
       if (disc_.pressure_pinned()) shift_pressure_to_zero_mean(space(), field);
       mesh_.set_coordinates(g.Xn1);
       // 5. the new level

@@ -17,6 +17,8 @@
 ///     `set_surface_velocities`), the body rows M delta_l Z / dt (+ w x I_w w) - M g - F_ext
 ///     - F_contact and their exact Jacobian (`add_rows`), and after the solve Z^{n+1} and the
 ///     hydrodynamic load (`finish`);
+///   - the hydrodynamic load of a driven body from the residual of the rows it would have if it
+///     were free (`driven_loads`);
 ///   - views for the contact model and the remesher, and the reset of the surface after a
 ///     remesh (`reset_surface`, `reset_surface_velocities`).
 /// The histories (centre, orientation, Z per level, loads, surface offsets) live in the flow
@@ -142,6 +144,7 @@ class BodySystem {
   void constrain(const Space& space, DofConstraints& cons, std::vector<char>& taken) {
     for (auto& e : entries_) {
       e.dofs.clear();
+      e.cells.clear();
       const bool free = M::is_free(e.data);
       if (free) e.extra = cons.add_unknowns(n_dof);
       for (Index i : space.velocity().boundary_dofs(M::tag(e.data))) {
@@ -161,6 +164,26 @@ class BodySystem {
           }
         }
       }
+    }
+    // the cells around driven bodies, whose element residuals give those bodies' loads
+    std::vector<int> owner(std::size_t(space.velocity().n_dofs()), -1);
+    bool any = false;
+    for (std::size_t k = 0; k < entries_.size(); ++k)
+      if (!M::is_free(entries_[k].data)) {
+        any = true;
+        for (Index i : entries_[k].dofs) owner[i] = int(k);
+      }
+    if (!any) return;
+    for (auto& e : entries_) e.dofs_sorted = e.dofs, std::sort(e.dofs_sorted.begin(), e.dofs_sorted.end());
+    const auto& mesh = space.mesh();
+    for (Index c = 0; c < mesh.n_cells(); ++c) {
+      int last = -1;
+      for (Index i : space.velocity().cell_dofs(c))
+        if (owner[i] >= 0 && owner[i] != last) {
+          auto& cells = entries_[std::size_t(owner[i])].cells;
+          if (cells.empty() || cells.back() != c) cells.push_back(c);
+          last = owner[i];
+        }
     }
   }
 
@@ -325,6 +348,41 @@ class BodySystem {
     }
   }
 
+  /// The hydrodynamic load of each driven body, from the residual of the rows its velocity
+  /// would have if it were free: F = -sum_i H(r_i)^T r_i over its surface DOFs i, r the element
+  /// residuals of the flow (`kernel`, set for the step) at `field` on the cells around the body,
+  /// H at X^{n+theta} (where the flow is integrated; the test functions of a free body's rows
+  /// too). For a free body this equals its momentum balance (`finish`) at convergence; this is
+  /// the consistent force, more accurate than integrating the stress over the surface. `Xth`:
+  /// the node positions at n+theta.
+  template <class Space, class Kernel>
+  void driven_loads(std::vector<State>& states, const Space& space, const Kernel& kernel, const VecX& field,
+                    const StepCoefficients& c, const std::vector<Vec<D>>& Xth) const {
+    using LocalVec = typename Kernel::LocalVec;
+    using LocalMat = typename Kernel::LocalMat;
+    constexpr int nv = Space::n_velocity_local;
+    LocalVec u, r;
+    LocalMat A;
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      const auto& e = entries_[k];
+      if (M::is_free(e.data)) continue;
+      const Vec<D> xg = c.theta * e.xg_next + (1 - c.theta) * states[k].centre[0];
+      Velocity F = Velocity::Zero();
+      for (Index cell : e.cells) {
+        const auto fd = space.cell_field_dofs(cell);
+        for (int l = 0; l < Space::n_local; ++l) u[l] = field[fd[l]];
+        kernel.cell(cell, u, A, r);
+        const auto& vd = space.velocity().cell_dofs(cell);
+        for (int a = 0; a < nv; ++a) {
+          if (!std::binary_search(e.dofs_sorted.begin(), e.dofs_sorted.end(), vd[a])) continue;
+          const auto H = M::rows(Vec<D>(space.velocity().point(vd[a], Xth) - xg));
+          for (int d = 0; d < D; ++d) F -= r[D * a + d] * H[d];
+        }
+      }
+      states[k].load = F;
+    }
+  }
+
   // ---- views and resets -------------------------------------------------------------------
 
   /// The bodies for a contact model at history level `level` (0: t^n), or at t^{n+1}
@@ -416,6 +474,8 @@ class BodySystem {
     Index extra = -1;                               // first of its n_dof extra unknowns (free bodies)
     std::vector<Index> nodes;                       // surface mesh nodes (sorted)
     std::vector<Index> dofs;                        // surface velocity DOFs
+    std::vector<Index> dofs_sorted;                 // the same, sorted (driven bodies)
+    std::vector<Index> cells;                       // cells with a surface velocity DOF (driven bodies)
     std::vector<typename Mesh<D>::Facet> facets;    // surface facets
     // the step's prediction
     Velocity Zhat = Velocity::Zero();               // extrapolated (or given) velocity

@@ -17,13 +17,14 @@
 //   <pair>/<D>D/repattern/N  the same with Assembler::rebuild and take_pattern into the previous matrix
 //                            (a remesh that reuses the previous pattern's memory)
 //   <pair>/<D>D/kernel/N     gather + StokesKernel::cell over all cells, no scatter
-//   <pair>/<D>D/kernel_quad/N  the same with StokesQuadratureKernel (the former kernel, for reference)
+//   <pair>/<D>D/kernel_quad/N  the same with StokesQuadratureKernel (the former kernel, now the test
+//                            oracle in tests/support/oracle_kernels.hpp, for reference)
 //   <pair>/<D>D/scatter/N    Assembler::scatter of one fixed element matrix/residual for every cell
 //   <pair>/<D>D/assemble/N   Assembler::assemble (zero J, gather, kernel, scatter), matrix + residual
 //   <pair>/<D>D/assemble_t2/N  the same on 2 threads (Assembler::set_threads(2))
 //   <pair>/<D>D/ns_<lin>[_kernel|_t2]/N  the same (assemble; kernel alone; 2 threads) with
 //                            AleNavierStokesKernel, Newton or semi-implicit (see NsInputs)
-//   <pair>/<D>D/ns_newton_kernel_quad/N  AleNavierStokesQuadratureKernel (the former kernel) alone
+//   <pair>/<D>D/ns_newton_kernel_quad/N  AleNavierStokesQuadratureKernel (the former kernel, the oracle) alone
 //   <pair>/<D>D/lu_<ord>/N   SparseLu<ord>: analyse, factorise, solve (times as counters), fill
 // Constraints as in Stokes::solve with every boundary tag Dirichlet: every velocity DOF on a
 // boundary facet fixed (lid velocity (1,0[,0]) on the top / ymax side, 0 elsewhere) and
@@ -65,6 +66,8 @@
 #include "alefsi/physics/navier_stokes.hpp"
 #include "alefsi/physics/stokes.hpp"
 
+#include "../tests/support/oracle_kernels.hpp"  // the former kernels, timed for reference
+
 namespace {
 
 using namespace alefsi;
@@ -90,6 +93,9 @@ double peak_mb() { return status_mb("VmHWM:"); }
 // short names for the benchmark labels (no '/', so that filters stay simple)
 template <class Pair>
 constexpr const char* label = std::is_same_v<Pair, TaylorHood> ? "P2P1" : "P1P1GLS";
+// the pair carries the GLS/PSPG terms (flop counts below)
+template <class Pair>
+constexpr bool gls = std::is_same_v<typename Pair::Stabilisation, GlsStabilisation>;
 
 template <int D>
 Mesh<D> make_mesh(int n) {
@@ -103,9 +109,9 @@ template <int D, class Pair>
 struct Problem {
   using Space = MixedSpace<D, Pair>;
   using Kernel = StokesKernel<D, Pair>;
-  using QuadKernel = StokesQuadratureKernel<D, Pair>;
+  using QuadKernel = testing::StokesQuadratureKernel<D, Pair>;
   using NsKernel = AleNavierStokesKernel<D, Pair>;
-  using NsQuadKernel = AleNavierStokesQuadratureKernel<D, Pair>;
+  using NsQuadKernel = testing::AleNavierStokesQuadratureKernel<D, Pair>;
   using Asm = Assembler<Space::n_local>;
   static constexpr int lid_tag = D == 2 ? tags::top : tags::ymax;
 
@@ -232,7 +238,7 @@ double flops_per_cell() {
   f += d * d + 2 * d * d * (2 * d - 1) * npairs;
   f += npairs * ((d - 1) + 1 + d * d + d + d * d) + (npairs - nv) * d * d;
   f += d * d + d * (2 * d - 1) * nv * np + 4 * d * nv * np;
-  if (Pair::stabilised) f += d * d * (2 * d - 1) + d * d + 1 + ppairs * 2 * d * d + ppairs + (ppairs - np);
+  if (gls<Pair>) f += d * d * (2 * d - 1) + d * d + 1 + ppairs * 2 * d * d + ppairs + (ppairs - np);
   return f + 2 * n * n;
 }
 
@@ -248,11 +254,11 @@ double flops_per_cell() {
 // P1/P1 (degree 4).
 template <int D, class Pair>
 double quad_flops_per_cell() {
-  using K = StokesQuadratureKernel<D, Pair>;
+  using K = testing::StokesQuadratureKernel<D, Pair>;
   constexpr double nv = K::nv, np = K::np, n = K::n_local, d = D;
   const int nq = simplex_quadrature<D>(2 * K::V::degree + 2).size();
   double per_q = 2 * nv * d * d + nv * nv * (3 * d + 1 + 3 * d * d) + 4 * nv * np * d;
-  if (Pair::stabilised) per_q += 2 * np * d * d + np * np * (2 * d + 2) + np * (2 * d + 2);
+  if (gls<Pair>) per_q += 2 * np * d * d + np * np * (2 * d + 2) + np * (2 * d + 2);
   const double per_cell = d * d + (D == 2 ? 10 : 50) + 2 * n * n;
   return nq * per_q + per_cell;
 }

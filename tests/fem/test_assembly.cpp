@@ -1,6 +1,7 @@
 // DOF maps, the constraint-aware local-to-global map and the sparse assembler: the assembled
 // Jacobian and residual equal T^T (sum_c P_c^T A_c P_c) T computed densely, for free, fixed and
-// linked (rigid-body-like) DOFs.
+// linked (rigid-body-like) DOFs. The Stokes and Navier-Stokes kernels against their quadrature
+// oracles (tests/support/oracle_kernels.hpp), GLS terms included.
 #include <catch2/catch.hpp>
 
 #include <array>
@@ -9,6 +10,7 @@
 #include <map>
 #include <numeric>
 #include <set>
+#include <type_traits>
 #include <vector>
 
 #include "alefsi/fem/constraints.hpp"
@@ -17,6 +19,8 @@
 #include "alefsi/mesh/generate/structured.hpp"
 #include "alefsi/physics/navier_stokes.hpp"
 #include "alefsi/physics/stokes.hpp"
+
+#include "../support/oracle_kernels.hpp"
 
 using namespace alefsi;
 
@@ -179,7 +183,7 @@ TEMPLATE_TEST_CASE("Stokes kernel from reference integrals equals the quadrature
     };
     const Real mu = 0.37;
     const StokesKernel<D, TestType> fast(space, mu, force);
-    const StokesQuadratureKernel<D, TestType> ref(space, mu, force);
+    const testing::StokesQuadratureKernel<D, TestType> ref(space, mu, force);
     using LocalVec = Eigen::Matrix<Real, Space::n_local, 1>;
     using LocalMat = Eigen::Matrix<Real, Space::n_local, Space::n_local>;
     Real worst_A = 0, worst_r = 0;
@@ -216,6 +220,41 @@ TEMPLATE_TEST_CASE("Stokes kernel from reference integrals equals the quadrature
   };
   check(std::integral_constant<int, 2>{});
   check(std::integral_constant<int, 3>{});
+}
+
+TEST_CASE("gls_tau: one parameter, its steady and small-dt limits; the kernels take it from their policy",
+          "[la][assembly][stabilisation][quick]") {
+  const Real h = 0.37, mu = 0.05, rho = 1.3;
+  // steady Stokes: computed as h^2 / (c1 mu), the limit of the general form
+  CHECK(gls_tau({.h = h, .mu = mu}) == h * h / (4 * mu));
+  CHECK(gls_tau({.h = h, .mu = mu}, 3.0) == h * h / (3 * mu));
+  CHECK(gls_tau({.h = h, .mu = mu, .rho = rho, .dt = 1e30}) == Approx(h * h / (4 * mu)).epsilon(1e-15));
+  CHECK(gls_tau({.h = h, .mu = mu, .rho = rho, .dt = 1e-9}) == Approx(1e-9 / (2 * rho)).epsilon(1e-9));
+  // convection lowers it: (2 rho |a| / h)^2 added under the root
+  const Real t_conv = gls_tau({.h = h, .mu = mu, .rho = rho, .dt = 0.1, .a_norm = 2.0});
+  CHECK(t_conv == Approx(1 / std::sqrt(std::pow(2 * rho / 0.1, 2) + std::pow(2 * rho * 2.0 / h, 2) +
+                                       std::pow(4 * mu / (h * h), 2))).epsilon(1e-15));
+  // the kernels
+  const auto mesh = distorted_mesh<2>(3);
+  MixedSpace<2, P1P1Gls> p1(mesh);
+  MixedSpace<2, TaylorHood> th(mesh);
+  const StokesKernel<2, P1P1Gls> stokes_gls(p1, mu);
+  const StokesKernel<2, TaylorHood> stokes_th(th, mu);
+  AleNavierStokesKernel<2, P1P1Gls> ns(p1, rho, mu);
+  StepInputs<2> in;
+  in.dt = 0.1;
+  ns.set_step(in);
+  for (Index c = 0; c < mesh.n_cells(); ++c) {
+    const Real hc = mesh.diameter(c);
+    CHECK(stokes_gls.tau(c) == gls_tau({.h = hc, .mu = mu}));
+    CHECK(stokes_th.tau(c) == 0);
+    CHECK(ns.tau(c, Vec<2>(2.0, 0.0)) == gls_tau({.h = hc, .mu = mu, .rho = rho, .dt = 0.1, .a_norm = 2.0}));
+  }
+  // no stabilisation: an empty policy with nothing to call at run time
+  STATIC_REQUIRE(std::is_empty_v<StokesKernel<3, TaylorHood>::Stabilisation>);
+  STATIC_REQUIRE(std::is_empty_v<AleNavierStokesKernel<3, TaylorHood>::Stabilisation>);
+  STATIC_REQUIRE(std::is_same_v<AleNavierStokesKernel<2, P1P1Gls, false>::Stabilisation,
+                                NavierStokesStabilisation<2, P1P1Gls, false, GlsStabilisation>>);
 }
 
 TEST_CASE("threaded assembly is bit-identical to one thread; a throwing kernel is reported", "[la][assembly][threads][quick]") {
@@ -279,7 +318,7 @@ TEST_CASE("threaded assembly is bit-identical to one thread; a throwing kernel i
 }
 
 namespace {
-// Compares AleNavierStokesKernel with AleNavierStokesQuadratureKernel cell by cell on a
+// Compares AleNavierStokesKernel with its oracle AleNavierStokesQuadratureKernel cell by cell on a
 // distorted mesh, with every step input set (theta < 1, history, u*, mesh velocity, force).
 template <int D, class Pair, bool Convection>
 void compare_ns_kernels(Linearisation lin) {
@@ -310,7 +349,7 @@ void compare_ns_kernels(Linearisation lin) {
     return f;
   };
   AleNavierStokesKernel<D, Pair, Convection> fast(space, 1.3, 0.05, lin);
-  AleNavierStokesQuadratureKernel<D, Pair, Convection> ref(space, 1.3, 0.05, lin);
+  testing::AleNavierStokesQuadratureKernel<D, Pair, Convection> ref(space, 1.3, 0.05, lin);
   fast.set_step(in);
   ref.set_step(in);
   Real worst_A = 0, worst_r = 0;

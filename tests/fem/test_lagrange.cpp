@@ -2,6 +2,8 @@
 // concept checks of the fem module.
 #include <catch2/catch.hpp>
 
+#include <type_traits>
+
 #include "alefsi/fem/concepts.hpp"
 #include "alefsi/fem/element_pair.hpp"
 #include "alefsi/fem/lagrange.hpp"
@@ -86,8 +88,24 @@ namespace {
 struct NotAnElement {
   static constexpr int dim = 2;
 };
-struct NotAPair {
+struct NotAPair {  // the elements, no name, no stabilisation tag (the former `stabilised` flag)
+  template <int D>
+  using Velocity = Lagrange<D, 2>;
+  template <int D>
+  using Pressure = Lagrange<D, 1>;
   static constexpr bool stabilised = false;
+};
+struct PairWithFlagNotTag : NotAPair {  // a name, but `Stabilisation` is not a tag
+  static constexpr const char* name = "P2/P1";
+  using Stabilisation = bool;
+};
+struct TagWithoutName {};
+struct PairWithUnnamedTag : LagrangePair<1, 1> {  // LagrangePair constrains its tag; this does not
+  static constexpr const char* name = "P1/P1-?";
+  using Stabilisation = TagWithoutName;
+};
+struct MyPair : LagrangePair<2, 1> {  // the minimal model of fem/concepts.hpp
+  static constexpr const char* name = "P2/P1";
 };
 }  // namespace
 
@@ -96,6 +114,17 @@ TEST_CASE("concepts accept the models and reject wrong types", "[fem][concepts][
   STATIC_REQUIRE(!ScalarElement<NotAnElement>);
   STATIC_REQUIRE(ElementPair<TaylorHood>);
   STATIC_REQUIRE(ElementPair<P1P1Gls>);
+  STATIC_REQUIRE(ElementPair<MyPair>);
   STATIC_REQUIRE(!ElementPair<NotAPair>);
+  STATIC_REQUIRE(!ElementPair<PairWithFlagNotTag>);
+  STATIC_REQUIRE(!ElementPair<PairWithUnnamedTag>);
   STATIC_REQUIRE(!ElementPair<Lagrange<2, 1>>);
+  STATIC_REQUIRE(StabilisationTag<NoStabilisation>);
+  STATIC_REQUIRE(StabilisationTag<GlsStabilisation>);
+  STATIC_REQUIRE(!StabilisationTag<TagWithoutName>);
+  STATIC_REQUIRE(!StabilisationTag<bool>);
+  // the pairs are compositions: the same P1 element, GLS on top for P1P1Gls only
+  STATIC_REQUIRE(std::is_same_v<TaylorHood::Stabilisation, NoStabilisation>);
+  STATIC_REQUIRE(std::is_same_v<P1P1Gls::Stabilisation, GlsStabilisation>);
+  STATIC_REQUIRE(std::is_same_v<P1P1Gls::Velocity<3>, TaylorHood::Pressure<3>>);
 }

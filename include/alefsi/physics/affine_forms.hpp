@@ -13,6 +13,8 @@
 ///   int_K phi_a phi_b         = det J  M_ab,                     M_ab = int_ref phi^_a phi^_b.
 /// (det J signed, as in the quadrature kernels: w_q det J.) The reference integrals are formed
 /// with a quadrature rule exact for them (degree 2k), once per (D, pair) and cached.
+/// `ReferenceTables` holds the element values and reference gradients at the points of a rule,
+/// for the terms still integrated by quadrature (body force, GLS).
 ///
 /// Storage is "structure of arrays" over the symmetric pairs a <= b (p = index of (a, b) in
 /// row-major upper-triangle order), padded to a multiple of 4 lanes, so that the per-cell
@@ -24,6 +26,7 @@
 ///     f.add_viscous(Jinv, detJ, mu, A);             // 2 mu (D(u), D(v))
 ///     f.add_divergence(Jinv, detJ, -1.0, -1.0, A);  // -(p, div v) - (q, div u)
 #include <array>
+#include <vector>
 
 #include "alefsi/core/types.hpp"
 #include "alefsi/fem/concepts.hpp"
@@ -50,6 +53,27 @@ struct SymmetricPairs {
 template <int N>
 inline constexpr SymmetricPairs<N> symmetric_pairs{};
 }  // namespace detail
+
+/// Element tables of a velocity/pressure pair at the points of a quadrature rule on the
+/// reference simplex (affine cells: physical gradients are reference gradients times J^-1).
+template <int D, ElementPair Pair>
+struct ReferenceTables {
+  using V = typename Pair::template Velocity<D>;
+  using P = typename Pair::template Pressure<D>;
+  explicit ReferenceTables(int degree) : rule(&simplex_quadrature<D>(degree)) {
+    for (int q = 0; q < rule->size(); ++q) {
+      phi_v.push_back(V::values(rule->points[q]));
+      dphi_v.push_back(V::gradients(rule->points[q]));
+      phi_p.push_back(P::values(rule->points[q]));
+      dphi_p.push_back(P::gradients(rule->points[q]));
+    }
+  }
+  const QuadratureRule<D>* rule;
+  std::vector<typename V::Values> phi_v;
+  std::vector<typename V::Gradients> dphi_v;
+  std::vector<typename P::Values> phi_p;
+  std::vector<typename P::Gradients> dphi_p;
+};
 
 template <int D, ElementPair Pair>
 class AffineStokesForms {

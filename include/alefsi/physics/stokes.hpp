@@ -2,13 +2,14 @@
 /// \file physics/stokes.hpp
 /// Steady Stokes flow with Taylor–Hood (P2/P1) or P1/P1 + PSPG/GLS elements.
 ///
-/// Weak form (mu: dynamic viscosity, f: body force per unit volume):
-///   find (u, p):  2 mu (D(u), D(v)) - (p, div v) - (q, div u)
-///                 - sum_K tau_K (grad p - mu lap u - f, grad q)_K = (f, v)   for all (v, q),
-/// where the last sum is present only for stabilised pairs (P1P1Gls; there lap u_h = 0 on each
-/// cell) with tau_K = h_K^2 / (c1 mu), c1 = 4, h_K = the longest edge of K (Codina 2001 with
-/// the convective and transient parts absent). The pressure block is then -C, C SPD, and the
-/// system is symmetric.
+/// Weak form (mu: dynamic viscosity [Pa s], f: body force per unit volume [N/m^3]):
+///   find (u, p):  2 mu (D(u), D(v)) - (p, div v) - (q, div u) + S_h((u, p), (v, q)) = (f, v) + L_h(q)
+/// for all (v, q), where S_h and L_h are the terms of the pair's stabilisation policy
+/// (`StokesStabilisation<D, Pair>`, physics/stabilisation.hpp): none for TaylorHood; for
+/// P1P1Gls the PSPG terms -sum_K tau_K (grad p - mu lap u - f, grad q)_K (lap u_h = 0 on each
+/// cell) with tau_K = h_K^2 / (c1 mu), c1 = 4, h_K = the longest edge of K (`gls_tau`, steady:
+/// Codina 2001 with the convective and transient parts absent). The pressure block is then -C,
+/// C SPD, and the system is symmetric.
 ///
 /// The residual form r(u) = A u - F is assembled at the current field (Dirichlet values
 /// included through `DofConstraints` offsets); one Newton step from any state solves the
@@ -32,37 +33,18 @@
 #include "alefsi/la/assembler.hpp"
 #include "alefsi/la/solvers.hpp"
 #include "alefsi/physics/affine_forms.hpp"
+#include "alefsi/physics/stabilisation.hpp"
 
 namespace alefsi {
 
 template <int D>
 using VectorFunction = std::function<Vec<D>(const Vec<D>&)>;
 
-/// Element tables of a velocity/pressure pair at the points of a quadrature rule on the
-/// reference simplex (affine cells: physical gradients are reference gradients times J^-1).
-template <int D, ElementPair Pair>
-struct ReferenceTables {
-  using V = typename Pair::template Velocity<D>;
-  using P = typename Pair::template Pressure<D>;
-  explicit ReferenceTables(int degree) : rule(&simplex_quadrature<D>(degree)) {
-    for (int q = 0; q < rule->size(); ++q) {
-      phi_v.push_back(V::values(rule->points[q]));
-      dphi_v.push_back(V::gradients(rule->points[q]));
-      phi_p.push_back(P::values(rule->points[q]));
-      dphi_p.push_back(P::gradients(rule->points[q]));
-    }
-  }
-  const QuadratureRule<D>* rule;
-  std::vector<typename V::Values> phi_v;
-  std::vector<typename V::Gradients> dphi_v;
-  std::vector<typename P::Values> phi_p;
-  std::vector<typename P::Gradients> dphi_p;
-};
-
 /// The Stokes element kernel (affine cells): A from precomputed reference integrals
-/// (`AffineStokesForms`: viscous, divergence and, for P1/P1-GLS, PSPG pressure blocks), no
-/// quadrature loop; the body-force load (if any) by quadrature of degree 2k + 2 as in
-/// `StokesQuadratureKernel`, which this kernel equals to round-off. r = A u - F.
+/// (`AffineStokesForms`: viscous and divergence blocks), no quadrature loop; the body-force
+/// load (if any) by quadrature of degree 2k + 2; the stabilisation's block of A and its part
+/// of F from the pair's policy `Stabilisation` (PSPG for P1/P1-GLS). r = A u - F. Equal to
+/// the quadrature oracle (tests/support/oracle_kernels.hpp) to round-off.
 /// `cell` is const and touches only its arguments: safe to call from several threads (the
 /// force function must then be too).
 template <int D, ElementPair Pair>
@@ -72,23 +54,21 @@ class StokesKernel {
   using V = typename Space::VelocityElement;
   using P = typename Space::PressureElement;
   using Forms = AffineStokesForms<D, Pair>;
+  using Stabilisation = StokesStabilisation<D, Pair>;
   static constexpr int nv = V::n_dofs, np = P::n_dofs, n_local = Space::n_local;
   using LocalVec = Eigen::Matrix<Real, n_local, 1>;
   using LocalMat = Eigen::Matrix<Real, n_local, n_local>;
 
-  /// `force` may be empty (no body force).
+  /// `force` may be empty (no body force). c1: the constant of tau (`gls_tau`).
   StokesKernel(const Space& space, Real mu, VectorFunction<D> force = {}, Real c1 = 4.0)
-      : space_(&space), mu_(mu), c1_(c1), f_(std::move(force)), forms_(&Forms::get()), tab_(2 * V::degree + 2) {
+      : space_(&space), mu_(mu), f_(std::move(force)), forms_(&Forms::get()), stab_(mu, c1),
+        tab_(2 * V::degree + 2) {
     ALEFSI_CHECK_ARG(mu > 0 && std::isfinite(mu), "mu", "viscosity must be positive and finite, got ", mu);
     ALEFSI_CHECK_ARG(c1 > 0, "c1", "GLS constant must be positive");
   }
 
-  /// GLS/PSPG parameter of cell c (0 for stable pairs).
-  Real tau(Index c) const {
-    if constexpr (!Pair::stabilised) return 0;
-    const Real h = space_->mesh().diameter(c);
-    return h * h / (c1_ * mu_);
-  }
+  /// Stabilisation parameter tau_K of cell c (0 for stable pairs).
+  Real tau(Index c) const { return stab_.tau(space_->mesh(), c); }
 
   void cell(Index c, const LocalVec& u, LocalMat& A, LocalVec& r) const {
     const Mat<D> J = space_->mesh().jacobian(c);
@@ -97,16 +77,13 @@ class StokesKernel {
     A.setZero();
     forms_->add_viscous(Jinv, detJ, mu_, A);
     forms_->add_divergence(Jinv, detJ, -1.0, -1.0, A);
-    Real tau_c = 0;
-    if constexpr (Pair::stabilised) {
-      tau_c = tau(c);
-      forms_->add_pressure_laplacian(Jinv, detJ, -tau_c, A);
-    }
+    const Real tau_c = tau(c);
+    stab_.add_matrix(*forms_, Jinv, detJ, tau_c, A);
     r.noalias() = A * u;
     if (f_) r -= load(c, J, Jinv, detJ, tau_c);
   }
 
-  /// The load vector F of cell c (body force; PSPG part for stabilised pairs).
+  /// The load vector F of cell c (body force, and the stabilisation's part with tau_c).
   LocalVec load(Index c, const Mat<D>& J, const Mat<D>& Jinv, Real detJ, Real tau_c) const {
     LocalVec F = LocalVec::Zero();
     const auto& mesh = space_->mesh();
@@ -118,100 +95,17 @@ class StokesKernel {
       const auto& phv = tab_.phi_v[q];
       for (int a = 0; a < nv; ++a)
         for (int i = 0; i < D; ++i) F[D * a + i] += w * fq[i] * phv[a];
-      if constexpr (Pair::stabilised) {
-        const Eigen::Matrix<Real, np, D> Gp = tab_.dphi_p[q] * Jinv;
-        for (int a = 0; a < np; ++a) F[D * nv + a] -= w * tau_c * fq.dot(Gp.row(a));
-      }
+      stab_.add_load(tab_, q, Jinv, w, tau_c, fq, F);
     }
     return F;
   }
 
  private:
   const Space* space_;
-  Real mu_, c1_;
+  Real mu_;
   VectorFunction<D> f_;
   const Forms* forms_;
-  ReferenceTables<D, Pair> tab_;
-};
-
-/// The Stokes element kernel by quadrature (degree 2k + 2, every term at every point): the
-/// reference implementation `StokesKernel` is tested against (same interface, same results to
-/// round-off, 5-10x slower).
-template <int D, ElementPair Pair>
-class StokesQuadratureKernel {
- public:
-  using Space = MixedSpace<D, Pair>;
-  using V = typename Space::VelocityElement;
-  using P = typename Space::PressureElement;
-  static constexpr int nv = V::n_dofs, np = P::n_dofs, n_local = Space::n_local;
-  using LocalVec = Eigen::Matrix<Real, n_local, 1>;
-  using LocalMat = Eigen::Matrix<Real, n_local, n_local>;
-
-  /// `force` may be empty (no body force).
-  StokesQuadratureKernel(const Space& space, Real mu, VectorFunction<D> force = {}, Real c1 = 4.0)
-      : space_(&space), mu_(mu), c1_(c1), f_(std::move(force)), tab_(2 * V::degree + 2) {
-    ALEFSI_CHECK_ARG(mu > 0 && std::isfinite(mu), "mu", "viscosity must be positive and finite, got ", mu);
-    ALEFSI_CHECK_ARG(c1 > 0, "c1", "GLS constant must be positive");
-  }
-
-  /// GLS/PSPG parameter of cell c (0 for stable pairs).
-  Real tau(Index c) const {
-    if constexpr (!Pair::stabilised) return 0;
-    const Real h = space_->mesh().diameter(c);
-    return h * h / (c1_ * mu_);
-  }
-
-  void cell(Index c, const LocalVec& u, LocalMat& A, LocalVec& r) const {
-    const auto& mesh = space_->mesh();
-    const Mat<D> J = mesh.jacobian(c);
-    const Mat<D> Jinv = J.inverse();
-    const Real detJ = J.determinant();
-    const Vec<D> x0 = mesh.node(mesh.cell(c)[0]);
-    const Real tau_c = tau(c);
-    A.setZero();
-    LocalVec F = LocalVec::Zero();
-    const auto& rule = *tab_.rule;
-    for (int q = 0; q < rule.size(); ++q) {
-      const Real w = rule.weights[q] * detJ;
-      const Eigen::Matrix<Real, nv, D> G = tab_.dphi_v[q] * Jinv;  // physical gradients
-      const auto& phv = tab_.phi_v[q];
-      const auto& php = tab_.phi_p[q];
-      for (int a = 0; a < nv; ++a)
-        for (int b = 0; b < nv; ++b) {
-          const Real gg = w * mu_ * G.row(a).dot(G.row(b));
-          for (int i = 0; i < D; ++i) {
-            A(D * a + i, D * b + i) += gg;
-            for (int j = 0; j < D; ++j) A(D * a + i, D * b + j) += w * mu_ * G(a, j) * G(b, i);
-          }
-        }
-      for (int a = 0; a < nv; ++a)
-        for (int b = 0; b < np; ++b)
-          for (int i = 0; i < D; ++i) {
-            const Real bdiv = -w * php[b] * G(a, i);
-            A(D * a + i, D * nv + b) += bdiv;
-            A(D * nv + b, D * a + i) += bdiv;
-          }
-      Vec<D> fq = Vec<D>::Zero();
-      if (f_) {
-        fq = f_(x0 + J * rule.points[q]);
-        for (int a = 0; a < nv; ++a)
-          for (int i = 0; i < D; ++i) F[D * a + i] += w * fq[i] * phv[a];
-      }
-      if constexpr (Pair::stabilised) {
-        const Eigen::Matrix<Real, np, D> Gp = tab_.dphi_p[q] * Jinv;
-        for (int a = 0; a < np; ++a) {
-          for (int b = 0; b < np; ++b) A(D * nv + a, D * nv + b) -= w * tau_c * Gp.row(a).dot(Gp.row(b));
-          F[D * nv + a] -= w * tau_c * fq.dot(Gp.row(a));
-        }
-      }
-    }
-    r = A * u - F;
-  }
-
- private:
-  const Space* space_;
-  Real mu_, c1_;
-  VectorFunction<D> f_;
+  [[no_unique_address]] Stabilisation stab_;  // empty without stabilisation
   ReferenceTables<D, Pair> tab_;
 };
 

@@ -11,7 +11,10 @@
 //                      [--solver sparselu|umfpack] [--startup-steps 10] [--energy-bound F]
 //                      [--probes DT1,DT2,...] [--remesh Q] [--remesh-size] [--u-bound F]
 //                      [--trace-every N]
+//   `--help` lists every option with its default; a run starts by echoing the values it uses.
+//   Quick check (a few seconds): --schemes BSS --mu 1 --h 0.1 --probes 0.1 --min-steps 5 --T 0.5
 //
+//   --schemes  by key (MR_AB) or display name (MR/AB), alefsi::dispatch_scheme.
 //   --solver   linear solver of the flow system: SparseLu<> (default; saddle-point AMD) or
 //              UmfPackLu (needs ALEFSI_HAVE_SUITESPARSE). Same results to solver round-off.
 //   --trace DT one run per scheme and mu at DT, printing per step: E, max |u|, E^{n+1}/E^n,
@@ -21,7 +24,7 @@
 //   --probes   runs these dt per scheme and mu (no bisection) and prints a table of outcomes.
 //   --remesh Q (--inner free only) AleFlow::set_remeshing with trigger quality Q, walls = the
 //              outer circle, no size function (the adaptation keeps the mesh's own edge lengths;
-//              only the quality triggers); the body is then declared a disk (radius R1) so the
+//              only the quality triggers); the body is a disk (radius R1, scenes::Annulus), so the
 //              adaptation keeps it on its circle. The probe line counts the remeshes.
 //   --remesh-size  with --remesh: target size uniform h, whose size band (an edge off h by
 //              more than 70 %) also triggers: in the sheared annulus that remeshes at most steps.
@@ -32,8 +35,9 @@
 // Problem (the annulus of the paper's Figure 7 set-up, WITHOUT the free inner body): fluid in
 // R1 = 0.25 < |x| < R2 = 1, rho = 1, mu from --mu (each value is a separate table row); the
 // outer cylinder turns at omega = 1 rad/s (u = omega (-y, x) on the outer wall, from t = 0:
-// impulsive start), the inner cylinder is a fixed no-slip wall (u = 0; rigid bodies are not in
-// AleFlow yet), fluid initially at rest. P1/P1-GLS on annulus_unstructured(R1, R2, h).
+// impulsive start), the inner cylinder is a fixed no-slip wall (u = 0; --inner free below makes
+// it the paper's free body), fluid initially at rest. P1/P1-GLS (--pair) on the scene's mesh
+// (alefsi/scenes/annulus.hpp: annulus_unstructured(R1, R2, h)).
 // Mesh motion (--mesh-motion):
 //   shear (default): the outer-wall nodes move with the wall (set_mesh_velocity(outer) = the
 //       rotation velocity), the inner-wall nodes stay, the interior follows the elasticity
@@ -83,9 +87,10 @@
 // (default 2 %); the result is lo, the largest dt found stable. It assumes stability is
 // monotone in dt, which bisection cannot check.
 //
-// --inner free: the paper's set-up (section 6.3, the Figure 7 case): the inner cylinder is a FREE
-// rigid body (density --rho-s, default 1.25: I = rho_s pi R1^4 / 2) driven by the fluid, coupled
-// monolithically (its (V1, V2, w3) are unknowns of the flow system). The outer wall's *mesh*
+// --inner free: the paper's set-up (section 6.3, the Figure 7 case: scenes::Annulus, the fluid
+// starting at rest): the inner cylinder is a FREE rigid body (density --rho-s, default 1.25:
+// I = rho_s pi R1^4 / 2) driven by the fluid, coupled monolithically (its (V1, V2, w3) are
+// unknowns of the flow system). The outer wall's *mesh*
 // velocity is 0 (only its fluid velocity turns: a tangential mesh velocity would move its nodes
 // off the circle), the body's surface nodes follow its exact rigid motion, the interior follows
 // the elasticity problem; --mesh-motion is ignored. The mesh shears as the body turns (by about
@@ -107,18 +112,19 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <functional>
-#include <numbers>
-#include <sstream>
+#include <iostream>
 #include <string>
 #include <vector>
 
+#include "alefsi/app/options.hpp"
 #include "alefsi/la/suitesparse.hpp"
 #include "alefsi/mesh/generate/mesher2d.hpp"
+#include "alefsi/scenes/annulus.hpp"
 #include "alefsi/sim/ale_flow.hpp"
+#include "alefsi/time/schemes.hpp"
 
 namespace {
 
@@ -128,9 +134,15 @@ using Clock = std::chrono::steady_clock;
 constexpr Real R1 = 0.25, R2 = 1.0, omega = 1.0, rho = 1.0;
 constexpr Real wall_speed = omega * R2;
 
+// The paper's annulus (alefsi/scenes/annulus.hpp), outer wall at omega from t = 0+; rho_s is the
+// free inner cylinder's density (--inner free).
+scenes::Annulus annulus(Real rho_s) {
+  return {.r1 = R1, .r2 = R2, .rho_s = rho_s, .omega = [](Real) { return omega; }};
+}
+
 struct Settings {
-  Real h = 0.05, T = 2, dt_lo = 0.005, dt_hi = 0.5, tol = 0.02;
-  int min_steps = 200, startup_steps = 10;
+  Real h = 0.05, T = -1, dt_lo = 0.005, dt_hi = 0.5, tol = 0.02;  // T < 0: 2, or 1 with --inner free
+  int min_steps = -1, startup_steps = 10;                          // min_steps < 0: 200, or 5 with --inner free
   Linearisation lin = Linearisation::newton;
   Real max_drift = -1;  // < 0: h; 0: no drift criterion
   Real energy_bound = 0;  // > 0: unstable if E > energy_bound * E_max (opt-in, see the header)
@@ -209,17 +221,12 @@ Probe run_probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool 
   p.target = std::max(s.min_steps, int(std::ceil(s.T / dt - 1e-9)));
   // energy check from here on: n >= startup_steps and t >= 10 h^2 rho / mu (<= 1 s)
   const Real t_startup = std::min(1.0, 10 * s.h * s.h * rho / mu);
+  const scenes::Annulus scene = annulus(s.rho_s);
   AleFlow<FlowConfig<2, Pair, Scheme, NavierStokes, Solver>> flow(mesh0, FlowOptions{rho, mu, s.lin, 25, 1e-10});
-  auto rotation = [](const Vec<2>& x, Real) { return Vec<2>(-omega * x[1], omega * x[0]); };
-  flow.set_velocity(tags::outer, rotation);
   if (s.free_body) {
-    // the paper's set-up: a free inner cylinder; outer-wall mesh velocity 0 (the default)
-    RigidBody2D body;
-    body.tag = tags::inner;
-    body.mass = s.rho_s * std::numbers::pi * R1 * R1;
-    body.inertia = 0.5 * body.mass * R1 * R1;
-    if (s.remesh_quality > 0) body.radius = R1;  // a disk: kept on its circle by the adaptation
-    flow.add_body(body);
+    // the paper's set-up: the outer wall's fluid velocity, its mesh velocity 0 (the default); a
+    // free inner cylinder, a disk (kept on its circle by the adaptation)
+    scene.configure(flow);
     if (s.remesh_quality > 0) {
       RemeshOptions ro{.enabled = true, .trigger_quality = s.remesh_quality,
                        .walls = {Circle{Vec<2>::Zero(), R2, tags::outer}}, .size = {}, .adapt = {}};
@@ -228,6 +235,9 @@ Probe run_probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool 
       flow.set_remeshing(std::move(ro));
     }
   } else {
+    // this benchmark's own variant: a fixed inner wall, the outer wall's nodes turning with it
+    auto rotation = [scene](const Vec<2>& x, Real t) { return scene.wall_velocity(x, t); };
+    flow.set_velocity(tags::outer, rotation);
     flow.set_velocity(tags::inner, [](const Vec<2>&, Real) { return Vec<2>(Vec<2>::Zero()); });
     flow.set_mesh_velocity(tags::outer, rotation);
     if (s.rigid) flow.set_mesh_velocity(tags::inner, rotation);  // nodes slide along the fixed inner wall
@@ -321,15 +331,17 @@ Probe run_probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool 
   return p;
 }
 
+// --pair and --solver: SparseLu<> in every build (the default), UMFPACK in a build with SuiteSparse.
 template <class Scheme>
 Probe probe(const Mesh<2>& mesh0, Real mu, Real dt, const Settings& s, bool trace) {
+  const auto with_solver = [&]<class Solver>() {
+    return s.taylor_hood ? run_probe<Scheme, TaylorHood, Solver>(mesh0, mu, dt, s, trace)
+                         : run_probe<Scheme, P1P1Gls, Solver>(mesh0, mu, dt, s, trace);
+  };
 #ifdef ALEFSI_HAVE_SUITESPARSE
-  if (s.umfpack)
-    return s.taylor_hood ? run_probe<Scheme, TaylorHood, UmfPackLu>(mesh0, mu, dt, s, trace)
-                         : run_probe<Scheme, P1P1Gls, UmfPackLu>(mesh0, mu, dt, s, trace);
+  if (s.umfpack) return with_solver.template operator()<UmfPackLu>();
 #endif
-  return s.taylor_hood ? run_probe<Scheme, TaylorHood, SparseLu<>>(mesh0, mu, dt, s, trace)
-                       : run_probe<Scheme, P1P1Gls, SparseLu<>>(mesh0, mu, dt, s, trace);
+  return with_solver.template operator()<SparseLu<>>();
 }
 
 struct Result {
@@ -389,217 +401,160 @@ Result bisect(const Mesh<2>& mesh, Real mu, const Settings& s) {
   return r;
 }
 
-using BisectFn = Result (*)(const Mesh<2>&, Real, const Settings&);
-using ProbeFn = Probe (*)(const Mesh<2>&, Real, Real, const Settings&, bool);
-struct SchemeEntry {
-  const char* key;
-  BisectFn bisect;
-  ProbeFn probe;
-};
-const std::vector<SchemeEntry> all_schemes{
-    {"MR_AB", bisect<MR_AB>, probe<MR_AB>},
-    {"BDF2_BDF2E", bisect<BDF2_BDF2E>, probe<BDF2_BDF2E>},
-    {"BDF2_AB", bisect<BDF2_AB>, probe<BDF2_AB>},
-    {"BDF3_BDF3E", bisect<BDF3_BDF3E>, probe<BDF3_BDF3E>},
-    {"BSS", bisect<BSS>, probe<BSS>},
-};
-
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
+// The numbers of a comma-separated list option (`option` names it in the error).
+std::vector<Real> numbers(const std::vector<std::string>& items, const std::string& option) {
+  std::vector<Real> out;
+  for (const auto& item : items) {
+    std::size_t used = 0;
+    Real v = 0;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    ALEFSI_CHECK_ARG(used == item.size() && std::isfinite(v), option, "expects numbers, got '", item, "'");
+    out.push_back(v);
+  }
   return out;
+}
+
+// "a" or "b": true for b; anything else throws naming the option.
+bool choice(const std::string& value, const char* option, const char* a, const char* b) {
+  ALEFSI_CHECK_ARG(value == a || value == b, option, "must be ", a, " or ", b, ", got '", value, "'");
+  return value == b;
 }
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   Settings s;
-  std::vector<std::string> schemes{"MR_AB", "BDF2_BDF2E", "BDF2_AB", "BDF3_BDF3E", "BSS"};
-  std::vector<Real> mus{1.0, 0.01};
-  std::string csv;
-  bool T_set = false, min_steps_set = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "%s needs a value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--schemes") schemes = split(next());
-    else if (a == "--h") s.h = std::atof(next().c_str());
-    else if (a == "--mu") {
-      mus.clear();
-      for (const auto& m : split(next())) mus.push_back(std::atof(m.c_str()));
-    } else if (a == "--T") s.T = std::atof(next().c_str()), T_set = true;
-    else if (a == "--min-steps") s.min_steps = std::atoi(next().c_str()), min_steps_set = true;
-    else if (a == "--startup-steps") s.startup_steps = std::atoi(next().c_str());
-    else if (a == "--remesh") s.remesh_quality = std::atof(next().c_str());
-    else if (a == "--remesh-size") s.remesh_size = true;
-    else if (a == "--probes") {
-      s.probe_dts.clear();
-      for (const auto& d : split(next())) s.probe_dts.push_back(std::atof(d.c_str()));
-    }
-    else if (a == "--inner") {
-      const std::string m = next();
-      if (m != "fixed" && m != "free") {
-        std::fprintf(stderr, "--inner fixed|free\n");
-        return 2;
-      }
-      s.free_body = m == "free";
-    } else if (a == "--rho-s") s.rho_s = std::atof(next().c_str());
-    else if (a == "--pair") {
-      const std::string m = next();
-      if (m != "gls" && m != "th") {
-        std::fprintf(stderr, "--pair gls|th\n");
-        return 2;
-      }
-      s.taylor_hood = m == "th";
-    }
-    else if (a == "--solver") {
-      const std::string m = next();
-      if (m != "sparselu" && m != "umfpack") {
-        std::fprintf(stderr, "--solver sparselu|umfpack\n");
-        return 2;
-      }
+  std::vector<std::string> schemes{"MR_AB", "BDF2_BDF2E", "BDF2_AB", "BDF3_BDF3E", "BSS"}, mu_list{"1", "0.01"},
+      probe_list;
+  std::string csv, inner = "fixed", pair = "gls", solver = "sparselu", lin = "newton", motion = "shear";
+  Options opt("ale_stability", "Largest stable time step of each ALE scheme on the annulus, by bisection (see the file comment).");
+  opt.add("schemes", schemes, "schemes, comma-separated (" + scheme_names() + ")")
+      .add("h", s.h, "mesh size")
+      .add("mu", mu_list, "viscosities, comma-separated (a table row each)")
+      .add("T", s.T, "run to max(T, min-steps dt) (< 0: 2, or 1 with --inner free)")
+      .add("min-steps", s.min_steps, "at least this many steps (< 0: 200, or 5 with --inner free)")
+      .add("startup-steps", s.startup_steps, "the energy test starts after this many steps")
+      .add("dt-lo", s.dt_lo, "bisection: the smallest dt")
+      .add("dt-hi", s.dt_hi, "bisection: the largest dt, tried first")
+      .add("tol", s.tol, "bisection: stop when dt_hi / dt_lo <= 1 + tol")
+      .add("lin", lin, "newton or semi (semi-implicit)")
+      .add("mesh-motion", motion, "shear or rigid (fixed inner wall only)")
+      .add("max-drift", s.max_drift, "a wall node this far off its circle fails the run (< 0: h, 0: off)")
+      .add("energy-bound", s.energy_bound, "unstable if E > F x E_max (0: off)")
+      .add("u-bound", s.u_bound, "unstable if max |u| > F x omega R2 after the start-up (0: off)")
+      .add("inner", inner, "fixed (a no-slip wall) or free (the paper's free rigid body)")
+      .add("rho-s", s.rho_s, "density of the free inner cylinder")
+      .add("pair", pair, "gls (P1/P1-GLS) or th (P2/P1)")
+      .add("solver", solver, "sparselu or umfpack (a build with SuiteSparse)")
+      .add("remesh", s.remesh_quality, "--inner free: remesh below this cell quality (0: off)")
+      .flag("remesh-size", s.remesh_size, "with --remesh: target size h (its size band triggers too)")
+      .add("probes", probe_list, "run these dt (comma-separated) instead of the bisection")
+      .add("trace", s.trace_dt, "one verbose run at this dt per scheme and mu (0: off)")
+      .add("trace-every", s.trace_every, "with --trace: print every N-th step (0: the first 12, then ~40 lines)")
+      .add("csv", csv, "CSV file of the bisection's results");
+  if (!opt.parse(argc, argv, std::cout)) return 0;
+  s.free_body = choice(inner, "--inner", "fixed", "free");
+  s.taylor_hood = choice(pair, "--pair", "gls", "th");
+  s.umfpack = choice(solver, "--solver", "sparselu", "umfpack");
 #ifndef ALEFSI_HAVE_SUITESPARSE
-      if (m == "umfpack") {
-        std::fprintf(stderr, "--solver umfpack: built without SuiteSparse (ALEFSI_HAVE_SUITESPARSE)\n");
-        return 2;
-      }
+  ALEFSI_CHECK_ARG(!s.umfpack, "--solver", "umfpack: built without SuiteSparse (ALEFSI_HAVE_SUITESPARSE)");
 #endif
-      s.umfpack = m == "umfpack";
-    }
-    else if (a == "--dt-lo") s.dt_lo = std::atof(next().c_str());
-    else if (a == "--dt-hi") s.dt_hi = std::atof(next().c_str());
-    else if (a == "--tol") s.tol = std::atof(next().c_str());
-    else if (a == "--lin") {
-      const std::string l = next();
-      if (l != "newton" && l != "semi") {
-        std::fprintf(stderr, "--lin newton|semi\n");
-        return 2;
-      }
-      s.lin = l == "newton" ? Linearisation::newton : Linearisation::semi_implicit;
-    } else if (a == "--csv") csv = next();
-    else if (a == "--energy-bound") s.energy_bound = std::atof(next().c_str());
-    else if (a == "--u-bound") s.u_bound = std::atof(next().c_str());
-    else if (a == "--max-drift") s.max_drift = std::atof(next().c_str());
-    else if (a == "--trace") s.trace_dt = std::atof(next().c_str());
-    else if (a == "--trace-every") s.trace_every = std::atoi(next().c_str());
-    else if (a == "--mesh-motion") {
-      const std::string m = next();
-      if (m != "shear" && m != "rigid") {
-        std::fprintf(stderr, "--mesh-motion shear|rigid\n");
-        return 2;
-      }
-      s.rigid = m == "rigid";
-    }
-    else {
-      std::fprintf(stderr,
-                   "usage: %s [--schemes MR_AB,BDF2_BDF2E,BDF2_AB,BDF3_BDF3E,BSS] [--h H] [--mu M1,M2] [--T T]\n"
-                   "          [--min-steps N] [--dt-lo DT] [--dt-hi DT] [--tol REL] [--lin newton|semi] [--csv FILE]\n"
-                   "          [--mesh-motion shear|rigid] [--max-drift D] [--energy-bound F]\n"
-                   "          [--trace DT] [--inner fixed|free] [--rho-s R] [--pair gls|th] [--solver sparselu|umfpack]\n"
-                   "          [--startup-steps N] [--probes DT1,DT2,...] [--remesh Q] [--remesh-size] [--u-bound F]\n"
-                   "          [--trace-every N]\n",
-                   argv[0]);
-      return 2;
-    }
-  }
-  if (s.free_body) {
-    if (!T_set) s.T = 1;
-    if (!min_steps_set) s.min_steps = 5;
-  }
-  if (s.remesh_quality != 0 && !(s.free_body && s.remesh_quality > 0 && s.remesh_quality < 1)) {
-    std::fprintf(stderr, "--remesh Q: needs --inner free and 0 < Q < 1\n");
-    return 2;
-  }
-  if (!(s.h > 0) || !(s.dt_lo > 0) || !(s.dt_hi > s.dt_lo) || !(s.tol > 0) || mus.empty() || s.startup_steps < 0 ||
-      std::any_of(s.probe_dts.begin(), s.probe_dts.end(), [](Real d) { return !(d > 0); })) {
-    std::fprintf(stderr, "invalid settings\n");
-    return 2;
-  }
-  std::vector<const SchemeEntry*> chosen;
-  for (const auto& k : schemes) {
-    auto it = std::find_if(all_schemes.begin(), all_schemes.end(), [&](const SchemeEntry& e) { return k == e.key; });
-    if (it == all_schemes.end()) {
-      std::fprintf(stderr, "unknown scheme %s\n", k.c_str());
-      return 2;
-    }
-    chosen.push_back(&*it);
-  }
-  try {
-    const auto tm = Clock::now();
-    const Mesh<2> mesh = annulus_unstructured(R1, R2, s.h);
-    std::printf("annulus R1=%g R2=%g, h=%g: %ld nodes, %ld triangles, %ld DOFs (P1/P1-GLS), meshed in %.2f s\n", R1, R2,
-                s.h, long(mesh.n_nodes()), long(mesh.n_cells()), long(3 * mesh.n_nodes()),
-                std::chrono::duration<double>(Clock::now() - tm).count());
-    if (s.free_body)
-      std::printf("inner cylinder: FREE rigid body, rho_s = %g (I = %.4g); outer-wall mesh velocity 0\n", s.rho_s,
-                  0.5 * s.rho_s * std::numbers::pi * std::pow(R1, 4));
-    std::printf("pair %s, linear solver %s\n", s.taylor_hood ? "P2/P1" : "P1/P1-GLS", s.umfpack ? "UMFPACK" : "SparseLU");
-    std::printf("omega=%g, rho=%g, %s, mesh motion %s, run to max(T=%g, %d steps), start-up %d steps, max drift %g, "
-                "bisection tol %g%%\n",
-                omega, rho, s.lin == Linearisation::newton ? "Newton" : "semi-implicit", s.free_body ? "elastic (free body)" : s.rigid ? "rigid" : "shear", s.T,
-                s.min_steps, s.startup_steps, s.max_drift < 0 ? s.h : s.max_drift, 100 * s.tol);
-    if (s.trace_dt > 0) {
-      for (Real mu : mus)
-        for (const auto* e : chosen) {
-          std::printf("%s, mu = %g, dt = %g:\n", e->key, mu, s.trace_dt);
-          print_probe(e->probe(mesh, mu, s.trace_dt, s, true));
-        }
-      return 0;
-    }
-    if (!s.probe_dts.empty()) {
-      std::vector<std::string> rows;
-      for (Real mu : mus)
-        for (const auto* e : chosen)
-          for (Real dt : s.probe_dts) {
-            std::printf("%s, mu = %g:\n", e->key, mu);
-            const Probe p = e->probe(mesh, mu, dt, s, false);
-            print_probe(p);
-            char row[256];
-            std::snprintf(row, sizeof row, "| %s | %g | %g | %s | %d/%d | %.3f | %.3f | %.3f | %.0f |", e->key, mu, dt,
-                          outcome_name(p.outcome), p.steps, p.target, p.t, p.umax, p.min_quality, p.cpu);
-            rows.push_back(row);
-          }
-      std::printf("\n| scheme | mu | dt | outcome | steps | t reached | max abs u | min quality | CPU (s) |\n|---|---|---|---|---|---|---|---|---|\n");
-      for (const auto& r : rows) std::printf("%s\n", r.c_str());
-      return 0;
-    }
-    std::vector<Result> results;
+  s.lin = choice(lin, "--lin", "newton", "semi") ? Linearisation::semi_implicit : Linearisation::newton;
+  s.rigid = choice(motion, "--mesh-motion", "shear", "rigid");
+  // the free body's runs are short: the mesh shears as it turns (file comment)
+  if (s.T < 0) s.T = s.free_body ? 1 : 2;
+  if (s.min_steps < 0) s.min_steps = s.free_body ? 5 : 200;
+  const std::vector<Real> mus = numbers(mu_list, "--mu");
+  s.probe_dts = numbers(probe_list, "--probes");
+  for (const auto& key : schemes) dispatch_scheme(key, []<class S>() {}, "--schemes");  // every name known
+  ALEFSI_CHECK_ARG(s.remesh_quality == 0 || (s.free_body && s.remesh_quality > 0 && s.remesh_quality < 1), "--remesh",
+                   "needs --inner free and 0 < Q < 1, got ", s.remesh_quality);
+  ALEFSI_CHECK_ARG(s.h > 0, "--h", "must be positive, got ", s.h);
+  ALEFSI_CHECK_ARG(s.dt_lo > 0, "--dt-lo", "must be positive, got ", s.dt_lo);
+  ALEFSI_CHECK_ARG(s.dt_hi > s.dt_lo, "--dt-hi", "must exceed --dt-lo, got ", s.dt_hi);
+  ALEFSI_CHECK_ARG(s.tol > 0, "--tol", "must be positive, got ", s.tol);
+  ALEFSI_CHECK_ARG(!mus.empty() && std::all_of(mus.begin(), mus.end(), [](Real m) { return m > 0; }), "--mu",
+                   "needs positive viscosities");
+  ALEFSI_CHECK_ARG(s.startup_steps >= 0, "--startup-steps", "must be >= 0, got ", s.startup_steps);
+  ALEFSI_CHECK_ARG(std::all_of(s.probe_dts.begin(), s.probe_dts.end(), [](Real d) { return d > 0; }), "--probes",
+                   "needs positive time steps");
+  opt.print(std::cout);
+
+  const auto tm = Clock::now();
+  const scenes::Annulus scene = annulus(s.rho_s);
+  const Mesh<2> mesh = scene.mesh(s.h);
+  std::printf("annulus R1=%g R2=%g, h=%g: %ld nodes, %ld triangles, %ld DOFs (P1/P1-GLS), meshed in %.2f s\n", R1, R2,
+              s.h, long(mesh.n_nodes()), long(mesh.n_cells()), long(3 * mesh.n_nodes()),
+              std::chrono::duration<double>(Clock::now() - tm).count());
+  if (s.free_body)
+    std::printf("inner cylinder: FREE rigid body, rho_s = %g (I = %.4g); outer-wall mesh velocity 0\n", s.rho_s,
+                scene.inner_body().inertia);
+  std::printf("pair %s, linear solver %s\n", s.taylor_hood ? "P2/P1" : "P1/P1-GLS", s.umfpack ? "UMFPACK" : "SparseLU");
+  std::printf("omega=%g, rho=%g, %s, mesh motion %s, run to max(T=%g, %d steps), start-up %d steps, max drift %g, "
+              "bisection tol %g%%\n",
+              omega, rho, s.lin == Linearisation::newton ? "Newton" : "semi-implicit", s.free_body ? "elastic (free body)" : s.rigid ? "rigid" : "shear", s.T,
+              s.min_steps, s.startup_steps, s.max_drift < 0 ? s.h : s.max_drift, 100 * s.tol);
+  // --- one verbose run per scheme and mu
+  if (s.trace_dt > 0) {
     for (Real mu : mus)
-      for (const auto* e : chosen) results.push_back(e->bisect(mesh, mu, s));
-    std::printf("\n| scheme | mu | largest stable dt | first unstable dt (reason, at t) | wall drift at dt_max | probes | wall (s) | CPU (s) |\n");
-    std::printf("|---|---|---|---|---|---|---|---|\n");
-    for (const auto& r : results) {
-      char fu[160] = "-";
-      if (r.first_unstable.dt > 0)
-        std::snprintf(fu, sizeof fu, "%.4f (%s, t = %.3f)", r.first_unstable.dt, outcome_name(r.first_unstable.outcome),
-                      r.first_unstable.t);
-      char dr[32] = "-";
-      if (r.last_stable.dt > 0) std::snprintf(dr, sizeof dr, "%.1e", r.last_stable.drift);
-      std::printf("| %s | %g | %s | %s | %s | %d | %.0f | %.0f |\n", r.scheme.c_str(), r.mu, r.dt_max.c_str(), fu, dr,
-                  r.probes, r.wall, r.cpu);
-    }
-    if (!csv.empty()) {
-      std::ofstream f(csv);
-      f << "scheme,inner,rho_s,mu,h,linearisation,dt_max,bracket_lo,bracket_hi,first_unstable_reason,first_unstable_t,"
-           "drift_at_dt_max,probes,wall_s,cpu_s\n";
-      for (const auto& r : results)
-        f << r.scheme << ',' << (s.free_body ? "free" : "fixed") << ',' << (s.free_body ? s.rho_s : 0.0) << ',' << r.mu << ',' << s.h << ',' << (s.lin == Linearisation::newton ? "Newton" : "semi-implicit")
-          << ',' << r.dt_max << ',' << r.lo << ',' << r.hi << ','
-          << (r.first_unstable.dt > 0 ? outcome_name(r.first_unstable.outcome) : "") << ',' << r.first_unstable.t << ','
-          << r.last_stable.drift << ',' << r.probes << ',' << r.wall << ',' << r.cpu << '\n';
-      std::printf("wrote %s\n", csv.c_str());
-    }
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
+      for (const auto& key : schemes) {
+        std::printf("%s, mu = %g, dt = %g:\n", key.c_str(), mu, s.trace_dt);
+        dispatch_scheme(key, [&]<class Scheme>() { print_probe(probe<Scheme>(mesh, mu, s.trace_dt, s, true)); });
+      }
+    return 0;
+  }
+  // --- the given time steps, no bisection
+  if (!s.probe_dts.empty()) {
+    std::vector<std::string> rows;
+    for (Real mu : mus)
+      for (const auto& key : schemes)
+        for (Real dt : s.probe_dts) {
+          std::printf("%s, mu = %g:\n", key.c_str(), mu);
+          const Probe p = dispatch_scheme(key, [&]<class Scheme>() { return probe<Scheme>(mesh, mu, dt, s, false); });
+          print_probe(p);
+          char row[256];
+          std::snprintf(row, sizeof row, "| %s | %g | %g | %s | %d/%d | %.3f | %.3f | %.3f | %.0f |", key.c_str(), mu, dt,
+                        outcome_name(p.outcome), p.steps, p.target, p.t, p.umax, p.min_quality, p.cpu);
+          rows.push_back(row);
+        }
+    std::printf("\n| scheme | mu | dt | outcome | steps | t reached | max abs u | min quality | CPU (s) |\n|---|---|---|---|---|---|---|---|---|\n");
+    for (const auto& r : rows) std::printf("%s\n", r.c_str());
+    return 0;
+  }
+  // --- the bisection
+  std::vector<Result> results;
+  for (Real mu : mus)
+    for (const auto& key : schemes)
+      results.push_back(dispatch_scheme(key, [&]<class Scheme>() { return bisect<Scheme>(mesh, mu, s); }));
+  std::printf("\n| scheme | mu | largest stable dt | first unstable dt (reason, at t) | wall drift at dt_max | probes | wall (s) | CPU (s) |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
+  for (const auto& r : results) {
+    char fu[160] = "-";
+    if (r.first_unstable.dt > 0)
+      std::snprintf(fu, sizeof fu, "%.4f (%s, t = %.3f)", r.first_unstable.dt, outcome_name(r.first_unstable.outcome),
+                    r.first_unstable.t);
+    char dr[32] = "-";
+    if (r.last_stable.dt > 0) std::snprintf(dr, sizeof dr, "%.1e", r.last_stable.drift);
+    std::printf("| %s | %g | %s | %s | %s | %d | %.0f | %.0f |\n", r.scheme.c_str(), r.mu, r.dt_max.c_str(), fu, dr,
+                r.probes, r.wall, r.cpu);
+  }
+  if (!csv.empty()) {
+    std::ofstream f(csv);
+    f << "scheme,inner,rho_s,mu,h,linearisation,dt_max,bracket_lo,bracket_hi,first_unstable_reason,first_unstable_t,"
+         "drift_at_dt_max,probes,wall_s,cpu_s\n";
+    for (const auto& r : results)
+      f << r.scheme << ',' << (s.free_body ? "free" : "fixed") << ',' << (s.free_body ? s.rho_s : 0.0) << ',' << r.mu << ',' << s.h << ',' << (s.lin == Linearisation::newton ? "Newton" : "semi-implicit")
+        << ',' << r.dt_max << ',' << r.lo << ',' << r.hi << ','
+        << (r.first_unstable.dt > 0 ? outcome_name(r.first_unstable.outcome) : "") << ',' << r.first_unstable.t << ','
+        << r.last_stable.drift << ',' << r.probes << ',' << r.wall << ',' << r.cpu << '\n';
+    std::printf("wrote %s\n", csv.c_str());
   }
   return 0;
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "ale_stability: %s\n", e.what());
+  return 1;
 }

@@ -21,21 +21,24 @@
 //
 // How to run: ./sphere_squirmer [--h0 0.04] [--growth 0.5] [--half-side 100] [--hmax 50]
 //             [--mesh octant|full] [--msh FILE] [--geo FILE] [--output DIR] [--no-translation]
-//             [--grid 161]
-// What it prints: mesh and DOF counts, V and w of the squirmer with their errors against the
-// exact values, the net force and torque the walls feel from the stress integral over them (zero
-// for a force- and torque-free body; relative to the drag 6 pi mu R |V| of a sphere at the same
-// speed, and to that drag times H), the drag passed on to the walls in the translation case, wall and CPU
-// times of each phase and the peak memory (getrusage). It writes into DIR (default
-// sphere_squirmer_out): squirmer.vtu and translation.vtu (P1 vertex values of velocity and
-// pressure), plane_<case>_{near,far}.csv (the velocity sampled on z = 0: x, y, ux, uy, uz;
-// NaN inside the sphere) and decay.csv (|u| against r along the x and y axes, the diagonal and
-// averaged over 200 directions, both cases). `python3 examples/plot_sphere_squirmer.py DIR`
-// draws Figure 3 (streamlines on z = 0) and Figure 4 (|u| against r, log-log).
+//             [--grid 161]   (`--help` lists the options with their defaults; a quick run:
+//             --h0 0.08 --growth 0.3 --hmax 20 --no-translation)
+// What it prints: the options it ran with, mesh and DOF counts, V and w of the squirmer with
+// their errors against the exact values, the net force and torque the walls feel from the
+// stress integral over them (zero for a force- and torque-free body; relative to the drag
+// 6 pi mu R |V| of a sphere at the same speed, and to that drag times H), the drag passed on to
+// the walls in the translation case, wall and CPU times of each phase and the peak memory
+// (getrusage). It writes into DIR (default sphere_squirmer_out): squirmer.vtu and
+// translation.vtu (P1 vertex values of velocity and pressure), plane_<case>_{near,far}.csv (the
+// velocity sampled on z = 0: x, y, ux, uy, uz; NaN inside the sphere) and decay.csv (|u|
+// against r along the x and y axes, the diagonal and averaged over 200 directions, both cases).
+// `python3 examples/plot_sphere_squirmer.py DIR` draws Figure 3 (streamlines on z = 0) and
+// Figure 4 (|u| against r, log-log).
 // Expected: |V_x - 1/3| / (1/3) under 1 % from h0 = R / 3 on (0.03 % at the default R / 6),
 // spurious V_y, V_z, w at round-off level on the symmetric mesh (docs/results.md has the
 // measured table and the resolution and box-size study).
 #include <alefsi/alefsi.hpp>
+#include <alefsi/app.hpp>
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -58,23 +61,19 @@
 using namespace alefsi;
 using std::numbers::pi;
 
-// UMFPACK (symmetric strategy) was the fastest of UMFPACK symmetric / automatic / unsymmetric
-// and SparseLu<> on the 40k-unknown mesh (10 / 10 / 20 / 27 s CPU), SparseLu the leanest
-// (0.9 GB against 1.5 GB); UMFPACK's 32-bit version (Eigen's wrapper) stops with "out of
-// memory" near 9e4 unknowns (docs/results.md).
-#if defined(ALEFSI_HAVE_SUITESPARSE)
-using Solver = UmfPackLu;  // la/suitesparse.hpp: multifrontal LU, symmetric strategy
-#else
-using Solver = SparseLu<>;
-#endif
-using Flow = AleFlow<FlowConfig<3, TaylorHood, BSS, UnsteadyStokes, Solver>>;
+// DefaultDirectSolver: UMFPACK (symmetric strategy) when alefsi was built with SuiteSparse, else
+// SparseLu<>. UMFPACK was the fastest of UMFPACK symmetric / automatic / unsymmetric and
+// SparseLu<> on the 40k-unknown mesh (10 / 10 / 20 / 27 s CPU), SparseLu the leanest (0.9 GB
+// against 1.5 GB); UMFPACK's 32-bit version (Eigen's wrapper) stops with "out of memory" near
+// 9e4 unknowns (docs/results.md).
+using Flow = AleFlow<FlowConfig<3, TaylorHood, BSS, UnsteadyStokes, DefaultDirectSolver>>;
 
 namespace {
 constexpr Real R = 0.25;
 constexpr int tag_walls = 1, tag_sphere = 5;
 
 // --- options -----------------------------------------------------------------------------------
-struct Options {
+struct Settings {
   Real h0 = 0.04, growth = 0.5, half_side = 100, hmax = 50;
   bool octant = true, translation = true;
   int grid = 161;
@@ -82,34 +81,30 @@ struct Options {
   std::filesystem::path output = "sphere_squirmer_out";
 };
 
-Options parse(int argc, char** argv) {
-  Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw InvalidArgument(a, "needs a value");
-      return argv[++i];
-    };
-    if (a == "--h0") o.h0 = std::stod(value());
-    else if (a == "--growth") o.growth = std::stod(value());
-    else if (a == "--half-side") o.half_side = std::stod(value());
-    else if (a == "--hmax") o.hmax = std::stod(value());
-    else if (a == "--mesh") {
-      const std::string m = value();
-      ALEFSI_CHECK_ARG(m == "octant" || m == "full", "--mesh", "must be octant or full, got ", m);
-      o.octant = m == "octant";
-    } else if (a == "--msh") o.msh = value();
-    else if (a == "--geo") o.geo = value();
-    else if (a == "--output") o.output = value();
-    else if (a == "--no-translation") o.translation = false;
-    else if (a == "--grid") o.grid = std::stoi(value());
-    else throw InvalidArgument(a, "unknown option (see the comment at the top of sphere_squirmer.cpp)");
-  }
+// false after --help
+bool parse(int argc, char** argv, Settings& o) {
+  std::string mesh = "octant";
+  Options opt("sphere_squirmer",
+              "Stokes flow about a sphere squirmer in a cube (paper 6.1, Figures 3 and 4); meshed by gmsh.");
+  opt.add("h0", o.h0, "mesh size on the sphere (R = 0.25)")
+      .add("growth", o.growth, "mesh-size growth g: h = h0 + g d at a distance d from the sphere")
+      .add("half-side", o.half_side, "half the side H of the cube")
+      .add("hmax", o.hmax, "largest mesh size (the cap on h)")
+      .add("mesh", mesh, "octant (mirrored into the eight octants: symmetric) or full")
+      .add("msh", o.msh, "read this gmsh mesh instead of running gmsh ('': run gmsh)")
+      .add("geo", o.geo, "the gmsh geometry")
+      .add("output", o.output, "folder for the VTU and CSV files (and gmsh's mesh.msh)")
+      .flag("translation", o.translation, "also the sedimentation-like case (--no-translation: skip it)")
+      .add("grid", o.grid, "points per side of the z = 0 sampling grids");
+  if (!opt.parse(argc, argv, std::cout)) return false;
+  ALEFSI_CHECK_ARG(mesh == "octant" || mesh == "full", "--mesh", "must be octant or full, got ", mesh);
+  o.octant = mesh == "octant";
   ALEFSI_CHECK_ARG(o.h0 > 0 && o.h0 < R, "--h0", "must be in (0, R = 0.25), got ", o.h0);
   ALEFSI_CHECK_ARG(o.growth > 0, "--growth", "must be positive, got ", o.growth);
   ALEFSI_CHECK_ARG(o.half_side > 2 * R, "--half-side", "must exceed 2 R = 0.5, got ", o.half_side);
   ALEFSI_CHECK_ARG(o.grid >= 11, "--grid", "must be >= 11, got ", o.grid);
-  return o;
+  opt.print(std::cout);
+  return true;
 }
 
 // --- timing and memory -------------------------------------------------------------------------
@@ -145,7 +140,7 @@ struct Stopwatch {
 
 // --- the mesh ----------------------------------------------------------------------------------
 // gmsh on the .geo; throws a clear Error when the executable is not there.
-std::filesystem::path run_gmsh(const Options& o) {
+std::filesystem::path run_gmsh(const Settings& o) {
   if (std::system("gmsh --version > /dev/null 2>&1") != 0)
     throw Error("the gmsh executable was not found on PATH (Debian/Ubuntu: apt install gmsh); or pass a mesh "
                 "made from examples/sphere_squirmer.geo with --msh FILE");
@@ -369,7 +364,8 @@ void print_report(const StepReport& rep) {
 }  // namespace
 
 int main(int argc, char** argv) try {
-  const Options o = parse(argc, argv);
+  Settings o;
+  if (!parse(argc, argv, o)) return 0;
   std::filesystem::create_directories(o.output);
   const Real H = o.half_side, mu = 1;
   const Vec<3> Q(-1, 0, 0), east(1, 0, 0), V_exact(1.0 / 3, 0, 0);

@@ -31,22 +31,25 @@
 // would see the Stokes paradox, errors ~ 1 / ln(L / R).)
 //
 // How to run: ./squirmer2d_convergence [--pair th|gls] [--hbox R/h] [--lmax L/R] [--hmax R/h]
-//                                      [--csv FILE]
+//                                      [--csv FILE]   (`--help` lists them with their defaults)
 //   defaults: P2/P1, box study at h_body = R / 32, L / R = 4 .. 256, mesh study h_body = R / 4
-//   .. R / 32 (R / hmax) in the L = 256 R box and the b = 128 R container (about 2 minutes).
-// What it prints: two markdown tables (box study, mesh study) with U, the errors, observed
-// rates, mesh sizes and solve times, and the CSV named by --csv.
+//   .. R / 32 (R / hmax) in the L = 256 R box and the b = 128 R container (about 2 minutes);
+//   the quickest run: --hbox 4 --lmax 8 --hmax 4.
+// What it prints: the options it ran with, two markdown tables (box study, mesh study) with U,
+// the errors, observed rates, mesh sizes and solve times, and the CSV named by --csv.
 // Expected (measured, docs/results.md "2D squirmer: speed against Blake's B1/2"): the box error
 // decays as (R/L)^2 (rates 1.98-2.00) and dominates: the square box's error is -7.1 (R/L)^2
 // (the container: its exact U_b to 6e-4 at b = 2R, 2e-5 from b = 16R on); the discretisation
 // error (container against U_b, every mesh size scaled together) is 4e-4 .. 1e-3 at
 // h = R / 4 and <= 5e-6 from h = R / 16 on, below the box error of every box up to L = 256 R.
 #include <alefsi/alefsi.hpp>
+#include <alefsi/app.hpp>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iostream>
 #include <string>
 
 using namespace alefsi;
@@ -54,11 +57,9 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-#ifdef ALEFSI_HAVE_SUITESPARSE
-using Solver = UmfPackLu;
-#else
-using Solver = SparseLu<>;
-#endif
+// One factorisation per mesh: UMFPACK when alefsi was built with SuiteSparse, else SparseLU with
+// the saddle-point AMD ordering (la/suitesparse.hpp).
+using Solver = DefaultDirectSolver;
 
 constexpr Real R = 1, B1 = 1, mu = 1;
 constexpr int body_tag = 5;
@@ -180,27 +181,20 @@ int study(int hbox, int lmax, int hmax, const std::string& csv_path) {
 int main(int argc, char** argv) try {
   std::string pair = "th", csv;
   int hbox = 32, lmax = 256, hmax = 32;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (i + 1 >= argc) {
-      std::fprintf(stderr, "usage: %s [--pair th|gls] [--hbox R/h] [--lmax L/R] [--hmax R/h] [--csv FILE]\n", argv[0]);
-      return 2;
-    }
-    const std::string v = argv[++i];
-    if (a == "--pair") pair = v;
-    else if (a == "--hbox") hbox = std::stoi(v);
-    else if (a == "--lmax") lmax = std::stoi(v);
-    else if (a == "--hmax") hmax = std::stoi(v);
-    else if (a == "--csv") csv = v;
-    else {
-      std::fprintf(stderr, "unknown option %s\n", a.c_str());
-      return 2;
-    }
-  }
-  if (hbox < 1 || lmax < 4 || hmax < 4) throw InvalidArgument("hbox", "need --hbox >= 1, --lmax >= 4, --hmax >= 4");
-  if (pair == "th") return study<TaylorHood>(hbox, lmax, hmax, csv);
-  if (pair == "gls") return study<P1P1Gls>(hbox, lmax, hmax, csv);
-  throw InvalidArgument("pair", "th or gls, got " + pair);
+  Options opt("squirmer2d_convergence",
+              "A 2D squirmer's speed against Blake's B1/2: box-size and mesh-size studies (see the file comment).");
+  opt.add("pair", pair, "th (P2/P1) or gls (P1/P1-GLS)")
+      .add("hbox", hbox, "box study: h_body = R / hbox")
+      .add("lmax", lmax, "box study: L / R = 4, 8, .., lmax; the mesh study's box")
+      .add("hmax", hmax, "mesh study: h_body = R / 4, R / 8, .., R / hmax")
+      .add("csv", csv, "CSV file of both studies ('': none)");
+  if (!opt.parse(argc, argv, std::cout)) return 0;
+  ALEFSI_CHECK_ARG(hbox >= 1, "--hbox", "must be >= 1, got ", hbox);
+  ALEFSI_CHECK_ARG(lmax >= 4, "--lmax", "must be >= 4, got ", lmax);
+  ALEFSI_CHECK_ARG(hmax >= 4, "--hmax", "must be >= 4, got ", hmax);
+  ALEFSI_CHECK_ARG(pair == "th" || pair == "gls", "--pair", "must be th or gls, got ", pair);
+  opt.print(std::cout);
+  return pair == "th" ? study<TaylorHood>(hbox, lmax, hmax, csv) : study<P1P1Gls>(hbox, lmax, hmax, csv);
 } catch (const std::exception& e) {
   std::fprintf(stderr, "squirmer2d_convergence: %s\n", e.what());
   return 1;

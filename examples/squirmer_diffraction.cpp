@@ -13,22 +13,25 @@
 // stays >= 24 R from the walls); both disks have density 1 (neutrally buoyant).
 //
 // How to run: ./squirmer_diffraction [--kappa 0,0.5,1,1.3,2,3] [--t-hat 48] [--dt 0.025]
-//             [--h-body 0.02] [--h-far 0.4] [--output DIR]
-// What it prints: v* (the squirmer alone, mean speed over 1 <= t <= 3 s), then per kappa the
-// squirmer's final angle and the passive disk's displacement at the end. It writes
+//             [--h-body 0.02] [--h-far 0.4] [--output DIR]   (`--help` lists the options with
+//             their defaults; the run lasts t-hat R / v* s per kappa)
+// What it prints: the options it ran with, v* (the squirmer alone, mean speed over
+// 1 <= t <= 3 s), then per kappa the squirmer's final position and angle and the passive disk's
+// displacement at the end. It writes
 // DIR/alone/bodies.csv and DIR/kappa_<k>/bodies.csv (box coordinates [0, 13] x [0, 8]: the
 // passive disk starts at (8, 4)); `python3 examples/plot_diffraction.py DIR` draws Figures 8-10.
 // Expected: v* within 1-2 % of 0.5; the squirmer is deflected away from the passive disk (its
 // angle leaves 0) the more the smaller kappa; the passive disk is pushed and drawn back.
 #include <alefsi/alefsi.hpp>
+#include <alefsi/app.hpp>
 
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 using namespace alefsi;
 using Flow = AleFlow<FlowConfig<2, P1P1Gls, BDF2_BDF2E>>;
@@ -77,34 +80,40 @@ Real run_scene(const Setup& s, bool passive, Real kappa, const std::filesystem::
   }
   return (x3 - x1) / 2;
 }
+
+// The numbers of a comma-separated list option (`option` names it in the error).
+std::vector<Real> numbers(const std::vector<std::string>& items, const std::string& option) {
+  std::vector<Real> out;
+  for (const auto& item : items) {
+    std::size_t used = 0;
+    Real v = 0;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    ALEFSI_CHECK_ARG(used == item.size() && std::isfinite(v), option, "expects numbers, got '", item, "'");
+    out.push_back(v);
+  }
+  return out;
+}
 }  // namespace
 
 int main(int argc, char** argv) try {
   Setup s{0.025, 0, 0.02, 0.4};
   Real t_hat = 48;
-  std::vector<Real> kappas = {0, 0.5, 1, 1.3, 2, 3};
+  std::vector<std::string> kappa_list = {"0", "0.5", "1", "1.3", "2", "3"};
   std::filesystem::path out = "output/squirmer_diffraction";
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (i + 1 >= argc) {
-      std::cerr << "usage: " << argv[0] << " [--kappa k1,k2,...] [--t-hat T] [--dt S] [--h-body CM] [--h-far CM] [--output DIR]\n";
-      return 2;
-    }
-    const std::string v = argv[++i];
-    if (a == "--kappa") {
-      kappas.clear();
-      std::stringstream ss(v);
-      for (std::string k; std::getline(ss, k, ',');) kappas.push_back(std::stod(k));
-    } else if (a == "--t-hat") t_hat = std::stod(v);
-    else if (a == "--dt") s.dt = std::stod(v);
-    else if (a == "--h-body") s.h_body = std::stod(v);
-    else if (a == "--h-far") s.h_far = std::stod(v);
-    else if (a == "--output") out = v;
-    else {
-      std::cerr << "unknown option " << a << "\n";
-      return 2;
-    }
-  }
+  Options opt("squirmer_diffraction", "A 2D squirmer passing a free passive disk (paper 6.4, Figures 8-10).");
+  opt.add("kappa", kappa_list, "initial offsets kappa = e / R of the squirmer's path, comma-separated")
+      .add("t-hat", t_hat, "run length per kappa in units of R / v* (t = t-hat R / v*)")
+      .add("dt", s.dt, "time step (s)")
+      .add("h-body", s.h_body, "mesh size at the disks (cm)")
+      .add("h-far", s.h_far, "mesh size far from the disks (cm)")
+      .add("output", out, "folder for alone/ and kappa_<k>/ (bodies.csv)");
+  if (!opt.parse(argc, argv, std::cout)) return 0;
+  const std::vector<Real> kappas = numbers(kappa_list, "--kappa");
+  opt.print(std::cout);
   const Real v_star = run_scene(s, false, 0, out / "alone");
   std::cout << "unperturbed squirmer speed v* = " << std::setprecision(4) << v_star
             << " cm/s (paper 0.49; unbounded 2D theory B1/2 = 0.5)\n";

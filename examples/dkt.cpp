@@ -17,7 +17,8 @@
 //
 // Configuration: element pair and scheme at compile time (CMake options ALEFSI_DKT_PAIR =
 // P1P1Gls | TaylorHood, ALEFSI_DKT_SCHEME = BDF2_BDF2E | BDF3_BDF3E | MR_AB | BDF2_AB | BSS;
-// default P1P1Gls + BDF2_BDF2E as in the paper's Figure 5); the scene is
+// default P1P1Gls + BDF2_BDF2E as in the paper's Figure 5; dkt_config.hpp), its flow compiled
+// once in dkt_flow.cpp (alefsi/sim/instantiate.hpp); the scene is
 // alefsi/scenes/settling.hpp's; at run time (`./dkt --help` lists every option with its
 // default): --dt, --t-end, --h-body, --h-far, --offset, --spring-range, --output, --vtu-every,
 // --checkpoint-every, --threads, --restart FILE, --newton, --no-collisions, --no-remeshing.
@@ -42,18 +43,10 @@
 #include <iostream>
 #include <string>
 
-#ifndef ALEFSI_DKT_PAIR
-#define ALEFSI_DKT_PAIR P1P1Gls
-#endif
-#ifndef ALEFSI_DKT_SCHEME
-#define ALEFSI_DKT_SCHEME BDF2_BDF2E
-#endif
+#include "dkt_config.hpp"
 
 using namespace alefsi;
-// SparseLU with the saddle-point AMD ordering (FlowConfig's default): on this scene's ~10^4
-// unknowns it factorises as fast as UMFPACK and solves 7x faster (no iterative refinement);
-// docs/results.md
-using Config = FlowConfig<2, ALEFSI_DKT_PAIR, ALEFSI_DKT_SCHEME>;
+using Config = DktConfig;  // dkt_config.hpp; AleFlow<Config> and run() are compiled in dkt_flow.cpp
 using Flow = AleFlow<Config>;
 
 int main(int argc, char** argv) try {

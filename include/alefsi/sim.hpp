@@ -12,6 +12,7 @@
 #include "alefsi/sim/discretisation.hpp"
 #include "alefsi/sim/driver.hpp"
 #include "alefsi/sim/flow_state.hpp"
+#include "alefsi/sim/instantiate.hpp"
 #include "alefsi/sim/kinematics.hpp"
 #include "alefsi/sim/mesh_velocity.hpp"
 #include "alefsi/sim/newton.hpp"

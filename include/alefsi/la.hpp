@@ -1,11 +1,12 @@
 #pragma once
 /// \file la.hpp
-/// The la module: sparse assembly, fill-reducing orderings and linear-solver policies: direct
-/// (SuiteSparse ones when alefsi was built with it), and the iterative saddle-point solver with
-/// its smoothed-aggregation AMG.
-#include "alefsi/la/amg.hpp"
+/// The la module: sparse assembly, fill-reducing orderings, the saddle-point blocks and the
+/// direct linear-solver policies (SuiteSparse ones when alefsi was built with it).
+/// Not included here: the iterative saddle-point solver `SaddlePointGmres` (la/krylov.hpp) and
+/// its AMG (la/amg.hpp). They add about 4 s to every translation unit that includes them
+/// (docs/performance.md, compile time), so a program includes them where it uses them.
 #include "alefsi/la/assembler.hpp"
-#include "alefsi/la/krylov.hpp"
 #include "alefsi/la/ordering.hpp"
+#include "alefsi/la/saddle_point_blocks.hpp"
 #include "alefsi/la/solvers.hpp"
 #include "alefsi/la/suitesparse.hpp"

@@ -25,7 +25,7 @@
 #include "alefsi/fem/constraints.hpp"
 #include "alefsi/fem/dofmap.hpp"
 #include "alefsi/la/assembler.hpp"
-#include "alefsi/la/krylov.hpp"
+#include "alefsi/la/saddle_point_blocks.hpp"
 #include "alefsi/mesh/mesh.hpp"
 #include "alefsi/physics/mesh_motion.hpp"
 #include "alefsi/physics/navier_stokes.hpp"
@@ -36,7 +36,8 @@
 
 namespace alefsi {
 
-/// A solver that takes the space's saddle-point blocks (la/krylov.hpp).
+/// A solver that takes the space's saddle-point blocks (la/saddle_point_blocks.hpp), e.g.
+/// SaddlePointGmres (la/krylov.hpp).
 template <class S>
 concept TakesSaddlePointBlocks = requires(S s, SaddlePointBlocks b) { s.set_blocks(std::move(b)); };
 

@@ -9,6 +9,7 @@ cd "$(dirname "$0")/.."
 
 packages=(cmake ninja-build g++ libeigen3-dev catch2 python3-vtk9 ccache libsuitesparse-dev libopenblas-dev)
 [ "$mode" = example ] && packages+=(python3-matplotlib)  # the example's PNG plots
+[ "$mode" = test ] && packages+=(clang-14 libclang-rt-14-dev)  # libFuzzer: the readers' fuzz tests
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -21,7 +22,9 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-cmake --preset release
+fuzz=()
+[ "$mode" = test ] && fuzz=(-DALEFSI_FUZZ=ON)  # the fuzz tests are part of the suite: required
+cmake --preset release "${fuzz[@]}"
 case "$mode" in
   example)
     # drafting, kissing and tumbling of two disks (paper 6.2) to t = 0.5 s, a few minutes

@@ -229,3 +229,47 @@ TEST_CASE("DFG benchmark 2D-1 (Schaefer & Turek 1996, Re = 20): the drag from th
   CHECK(cd >= 5.57);  // the benchmark's interval [5.57, 5.59]
   CHECK(cd <= 5.59);
 }
+
+TEST_CASE("a scene that cannot run is refused before anything is written, naming the body or parameter",
+          "[reliability][bodies][quick]") {
+  const scenes::Annulus scene;
+  const Mesh<2> mesh = annulus_mesh(scene.r1, scene.r2, 2, 16);
+  auto flow_with = [&](std::function<Vec<2>(const Vec<2>&)> slip) {
+    auto flow = std::make_unique<Annulus>(mesh, FlowOptions{.rho = 1, .mu = 1});
+    RigidBody2D b = scene.inner_body();
+    b.slip = std::move(slip);
+    flow->add_body(b);
+    return flow;
+  };
+  auto message = [](auto&& f) -> std::string {
+    try {
+      f();
+    } catch (const InvalidArgument& e) {
+      return e.what();
+    }
+    return "";
+  };
+  // a slip with a normal part (a uniform field: the body would be a source on one side)
+  const TempDir out("alefsi_bad_scene");
+  RunOptions ro = quiet(0.01, 0.05);
+  ro.output = out.path / "run";
+  auto bad = flow_with([](const Vec<2>&) { return Vec<2>(1, 0); });
+  const std::string m = message([&] { run(*bad, ro); });
+  CHECK(m.find("body.slip") != std::string::npos);
+  CHECK(m.find("bodies[0]") != std::string::npos);
+  CHECK(m.find("not tangential") != std::string::npos);
+  CHECK(!fs::exists(ro.output));  // nothing written
+  // the same field made tangential runs; so does a non-finite slip not (named)
+  auto good = flow_with(tangential_slip(Vec<2>(1, 0)));
+  CHECK_NOTHROW(good->prepare());
+  auto nan = flow_with([](const Vec<2>&) { return Vec<2>(std::numeric_limits<Real>::quiet_NaN(), 0); });
+  CHECK(message([&] { nan->prepare(); }).find("not finite") != std::string::npos);
+  // gravity with a NaN, named
+  CHECK(message([&] { good->set_gravity(Vec<2>(0, std::numeric_limits<Real>::quiet_NaN())); }).find("gravity") !=
+        std::string::npos);
+  // a body tag with no facets, named
+  RigidBody2D ghost = scene.inner_body();
+  ghost.tag = 77;
+  auto flow = std::make_unique<Annulus>(mesh, FlowOptions{.rho = 1, .mu = 1});
+  CHECK(message([&] { flow->add_body(ghost); }).find("body.tag") != std::string::npos);
+}

@@ -131,7 +131,10 @@ class AleFlow {
   void set_mesh_velocity(int tag, TimeFunction g) { mesh_velocity_.set_boundary(mesh_, tag, std::move(g)); }
   void set_prescribed_mesh_velocity(TimeFunction v) { mesh_velocity_.set_prescribed(std::move(v)); }
   /// Gravity: body force rho_f g on the fluid and M g on every free body.
-  void set_gravity(const Vec<D>& g) { gravity_ = g; }
+  void set_gravity(const Vec<D>& g) {
+    ALEFSI_CHECK_ARG(g.allFinite(), "gravity", "must be finite, got (", g.transpose(), ")");
+    gravity_ = g;
+  }
   /// Body force per unit volume f(x, t) on the fluid (besides gravity).
   void set_force(TimeFunction f) { force_ = std::move(f); }
   /// Adds a rigid body whose surface facets carry its tag; returns its index.
@@ -199,10 +202,17 @@ class AleFlow {
   std::vector<Real> body_gaps() const { return contact_->gaps(bodies_.contact_bodies(state_.bodies, 0)); }
 
   // ---- stepping ------------------------------------------------------------------------------
+  /// Checks the scene and builds what the first step needs (constraints, contact walls). A
+  /// scene that cannot be run is refused here with an `InvalidArgument` naming the body:
+  /// overlapping bodies, a surface node off its body's circle or sphere, a slip with a normal
+  /// part. The first step calls it; `run()` calls it before it writes any output.
+  void prepare() {
+    if (!disc_.constrained()) setup();
+  }
   /// Advances from t^n to t^n + dt.
   StepReport step(Real dt) {
     ALEFSI_CHECK_ARG(dt > 0 && std::isfinite(dt), "dt", "time step must be positive and finite, got ", dt);
-    if (!disc_.constrained()) setup();
+    prepare();
     if (stepper_.restarts(state_.time, dt)) {
       state_.time.restart();
       ++state_.stats.history_restarts;
@@ -303,6 +313,7 @@ class AleFlow {
     bodies_.attach(mesh_);
     disc_.constrain(dirichlet_, bodies_);
     bodies_.check_radii(mesh_, state_.bodies);
+    if (state_.stats.steps == 0) bodies_.check_slip(mesh_, state_.bodies);
     contact_->set_walls(mesh_, bodies_.tags());
     if (state_.stats.steps == 0)
       for (const auto& o : contact_->overlaps(bodies_.contact_bodies(state_.bodies, 0)))

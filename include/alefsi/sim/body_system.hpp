@@ -200,6 +200,30 @@ class BodySystem {
     }
   }
 
+  /// Disks and spheres with a slip: the slip at every surface node is finite and tangential
+  /// (its normal part at most 1 % of the body's largest slip; flux_free_slip's correction is
+  /// far smaller). A slip with a normal part would make the body a source or a sink.
+  void check_slip(const Mesh<D>& mesh, const std::vector<State>& states) const {
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      const auto& e = entries_[k];
+      if (!M::has_slip(e.data) || M::radius(e.data) <= 0) continue;
+      Real largest = 0, normal = 0;
+      Index worst = -1;
+      for (Index v : e.nodes) {
+        const Vec<D> r = M::to_body(mesh.node(v) - states[k].centre[0], states[k].orientation[0], e.data);
+        const Vec<D> us = M::slip(e.data, r);
+        ALEFSI_CHECK_ARG(us.allFinite(), "body.slip", "bodies[", k, "] (tag ", M::tag(e.data),
+                         "): the slip is not finite at surface node ", v);
+        largest = std::max(largest, us.norm());
+        const Real un = std::abs(us.dot(r.normalized()));
+        if (un > normal) normal = un, worst = v;
+      }
+      ALEFSI_CHECK_ARG(normal <= 1e-2 * largest, "body.slip", "bodies[", k, "] (tag ", M::tag(e.data),
+                       "): the slip is not tangential: its normal part is ", normal, " at surface node ", worst,
+                       ", the largest slip ", largest);
+    }
+  }
+
   // ---- one step ---------------------------------------------------------------------------
 
   /// The rigid velocities of the surface nodes on geometry x for the mesh-velocity problem,

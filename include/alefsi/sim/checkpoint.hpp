@@ -142,10 +142,9 @@ class CheckpointWriter {
 
 class CheckpointReader {
  public:
-  explicit CheckpointReader(std::filesystem::path file) : file_(std::move(file)) {
-    std::ifstream in(file_, std::ios::binary);
-    if (!in) throw IoError("checkpoint '" + file_.string() + "': cannot open");
-    data_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  explicit CheckpointReader(const std::filesystem::path& file) : CheckpointReader(file, read_file(file)) {}
+  /// A checkpoint held in memory (`bytes`, as a file would hold them); `name` names it in errors.
+  CheckpointReader(std::filesystem::path name, std::vector<char> bytes) : file_(std::move(name)), data_(std::move(bytes)) {
     if (data_.size() < 8 || std::memcmp(data_.data(), checkpoint_magic, 8) != 0)
       throw IoError("checkpoint '" + file_.string() + "': not an alefsi checkpoint (bad magic)");
     pos_ = 8;
@@ -232,6 +231,11 @@ class CheckpointReader {
   [[noreturn]] void fail(const std::string& why) const { throw IoError("checkpoint '" + file_.string() + "': " + why); }
 
  private:
+  static std::vector<char> read_file(const std::filesystem::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw IoError("checkpoint '" + file.string() + "': cannot open");
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
   // Every section's length and checksum, up to "end" and the end of the file: a file that is
   // not exactly what was written is refused before anything is read from it.
   void verify() const {

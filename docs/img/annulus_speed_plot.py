@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Speed against error on the annulus (docs/results.md, "Annulus: speed against error").
+"""Speed against error on the annulus (docs/results.md, "Speed against error (annulus, smooth start, mu = 1)").
 
     /usr/bin/python3 docs/img/annulus_speed_plot.py docs/img/annulus_speed.csv [out.png]
 

@@ -22,8 +22,9 @@
 ///       * with `SaddlePointBlocks` from the space (`saddle_point_blocks`), the Cahouet–Chabard
 ///         form S~^-1 = mu M_p^-1 + L^-1, M_p the pressure mass matrix (inverted by a few
 ///         Jacobi–Chebyshev steps) and, when the velocity block holds gamma M_u (a time step:
-///         gamma = rho a_0 / dt), L = B (gamma M_u,lumped)^-1 Bt + C (one AMG V-cycle);
-///       * without them (the policy default-constructed, as `AleFlow` does), algebraically:
+///         gamma = rho a_0 / (theta dt)), L = B (gamma M_u,lumped)^-1 Bt + C (one AMG V-cycle);
+///         `AleFlow` hands them over for every step (sim/discretisation.hpp);
+///       * without them (the policy used on its own, no `set_blocks`), algebraically:
 ///         S~ = diag(B diag(A_uu)^-1 Bt) + diag(C), a lumped stand-in for M_p / mu. It is
 ///         spectrally equivalent to M_p / mu on shape-regular meshes (steady Stokes: mesh-independent
 ///         iteration counts), but it has no Cahouet–Chabard part: with a dominant rho/dt mass

@@ -17,8 +17,8 @@
 //
 // Configuration: element pair and scheme at compile time (CMake options ALEFSI_DKT_PAIR =
 // P1P1Gls | TaylorHood, ALEFSI_DKT_SCHEME = BDF2_BDF2E | BDF3_BDF3E | MR_AB | BDF2_AB | BSS;
-// default P1P1Gls + BDF2_BDF2E as in the paper's Figure 5; dkt_config.hpp), its flow compiled
-// once in dkt_flow.cpp (alefsi/sim/instantiate.hpp); the scene is
+// default P1P1Gls + BDF2_BDF2E as in the paper's Figure 5; dkt_config.hpp), its flow and the
+// scene's mesh and set-up compiled once in dkt_flow.cpp (alefsi/sim/instantiate.hpp); the scene is
 // alefsi/scenes/settling.hpp's; at run time (`./dkt --help` lists every option with its
 // default): --dt, --t-end, --h-body, --h-far, --offset, --spring-range, --output, --vtu-every,
 // --checkpoint-every, --threads, --restart FILE, --newton, --no-collisions, --no-remeshing.
@@ -46,7 +46,7 @@
 #include "dkt_config.hpp"
 
 using namespace alefsi;
-using Config = DktConfig;  // dkt_config.hpp; AleFlow<Config> and run() are compiled in dkt_flow.cpp
+using Config = DktConfig;  // dkt_config.hpp; the flow, run() and the scene set-up are compiled in dkt_flow.cpp
 using Flow = AleFlow<Config>;
 
 int main(int argc, char** argv) try {
@@ -82,7 +82,7 @@ int main(int argc, char** argv) try {
   scene.collisions = collisions;
   scene.remeshing = remeshing;
   const Real R = scene.disks[0].radius;
-  Mesh<2> mesh = restart.empty() ? scene.mesh(h_body, h_far) : read_checkpoint_mesh<2>(restart);
+  Mesh<2> mesh = restart.empty() ? dkt_mesh(scene, h_body, h_far) : read_checkpoint_mesh<2>(restart);
   std::cout << "DKT with " << Flow::Space::VelocityElement::degree << "/1 elements (" << Config::Pair::name << "), "
             << Config::Scheme::name << ", " << Config::Solver::name << ", dt " << dt << ", offset " << offset
             << ", spring range " << spring_range << ": " << mesh.n_nodes() << " nodes, " << mesh.n_cells()

@@ -1,9 +1,10 @@
 #pragma once
 /// \file sim/instantiate.hpp
 /// Compile a scene's flow once. `AleFlow<Config>` and `run()` for it are most of what a scene's
-/// translation unit costs the compiler (kernels, assembly, Newton, remeshing, checkpoints:
-/// about two thirds of `examples/dkt.cpp`'s compile time, docs/performance.md). A scene that is
-/// edited often can say that they are compiled in another translation unit, compiled once:
+/// translation unit costs the compiler (kernels, assembly, Newton, remeshing, checkpoints; with
+/// the scene's set-up, 25 of the 43 s that `examples/dkt.cpp` took: docs/performance.md). A
+/// scene that is edited often can say that they are compiled in another translation unit,
+/// compiled once:
 ///
 ///     // scene_config.hpp, included by both files below
 ///     using MyConfig = alefsi::FlowConfig<2, alefsi::P1P1Gls, alefsi::BDF2_BDF2E>;

@@ -370,6 +370,13 @@ TEST_CASE("gmsh: invalid meshes throw MeshError naming the cell or facet", "[mes
   // the diagonal of the square tagged as a boundary line: (D-1)-element 4 is interior
   REQUIRE_THROWS_MATCHES(read_gmsh<2>(kDir + "bad/interior_facet_v22.msh"), MeshError,
                          MeshErrorIs(MeshError::Entity::facet, 4, "not a boundary facet"));
+  // and the message says which file, and the line of the element
+  try {
+    (void)read_gmsh<2>(kDir + "bad/degenerate_cell_v22.msh");
+    FAIL("no MeshError");
+  } catch (const MeshError& e) {
+    CHECK(std::string(e.what()).rfind(kDir + "bad/degenerate_cell_v22.msh:" + std::to_string(23) + ": cell 1: ", 0) == 0);
+  }
 }
 
 TEST_CASE("gmsh: a missing file is a ParseError on line 0", "[mesh][gmsh][quick]") {

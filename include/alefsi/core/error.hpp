@@ -44,8 +44,13 @@ class MeshError : public Error {
   Entity entity() const noexcept { return entity_; }
   /// Index of the offending cell / node / facet (-1 for a whole-mesh problem).
   Index index() const noexcept { return index_; }
+  /// The same error with where it comes from in front ("mesh.msh:12: cell 5: ...").
+  MeshError located(const std::string& where) const { return MeshError(entity_, index_, where + ": " + what(), Full{}); }
 
  private:
+  struct Full {};
+  MeshError(Entity entity, Index index, const std::string& message, Full)
+      : Error(message), entity_(entity), index_(index) {}
   static std::string describe(Entity e, Index i) {
     switch (e) {
       case Entity::cell: return "cell " + std::to_string(i) + ": ";

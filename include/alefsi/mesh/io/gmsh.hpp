@@ -32,7 +32,8 @@
 /// Errors: a malformed file throws ParseError(file, line, message) with the 1-based line of the
 /// offending line (inside a binary block: the line where that block starts; line 0 when the
 /// file cannot be opened). An invalid mesh (degenerate cell, a tagged (D-1)-element that is
-/// not on the boundary, ...) throws MeshError from the Mesh constructor.
+/// not on the boundary, ...) throws the Mesh constructor's MeshError (entity and index as it
+/// gives them), its message led by the file and the line of the offending element.
 ///
 ///     auto g = alefsi::read_gmsh<2>("channel.msh");   // gmsh -2 channel.geo -format msh41
 ///     const alefsi::Mesh<2>& mesh = g.mesh;
@@ -168,6 +169,7 @@ class GmshCursor {
   [[noreturn]] void fail(std::size_t line, const std::string& what) const { throw ParseError(file_, line, what); }
   [[noreturn]] void fail(const std::string& what) const { fail(rec_line_, what); }
 
+  const std::string& file() const { return file_; }
   bool binary() const { return binary_; }
   bool swapped() const { return swap_; }
   void set_binary(bool b, bool swap) {
@@ -954,9 +956,14 @@ class GmshReader {
     GmshMesh<D> out;
     try {
       out.mesh = Mesh<D>(std::move(x), cells, facets, facet_phys_, std::move(cell_phys_));
-    } catch (const MeshError&) {
+    } catch (const MeshError& e) {
       check_duplicates<nv>(cells, cell_line_, cell_word);  // a clearer diagnosis if it applies
-      throw;
+      // the same error, located: the file and the line of the offending element
+      const std::vector<std::size_t>* lines = e.entity() == MeshError::Entity::cell    ? &cell_line_
+                                              : e.entity() == MeshError::Entity::facet ? &facet_line_
+                                                                                       : nullptr;
+      const bool known = lines && e.index() >= 0 && std::size_t(e.index()) < lines->size();
+      throw e.located(cur_.file() + (known ? ":" + std::to_string((*lines)[std::size_t(e.index())]) : std::string()));
     }
     check_duplicate_cells(out.mesh);
     out.physical_names = std::move(names_);

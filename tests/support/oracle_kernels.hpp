@@ -4,9 +4,12 @@
 // library's kernels with them cell by cell, bench/bench_assembly.cpp times them for reference.
 // Not part of the library (not installed); namespace alefsi::testing.
 //
-// They were written independently of the fast kernels on purpose: the GLS terms (SUPG, PSPG)
-// are integrated here by their own quadrature, branching on the pair's tag; only the parameter
-// tau is shared (alefsi::gls_tau), so that a comparison tests the terms, not two copies of tau.
+// The Galerkin terms are integrated here point by point, independently of the fast kernels'
+// reference integrals. The GLS terms (SUPG, PSPG) are the former kernel's loops, from which
+// physics/stabilisation.hpp's policy was extracted: the same formulas, branching here on the
+// pair's tag. For them a comparison checks that the policy kept the former kernel's terms, not
+// the terms themselves (an independent check, e.g. against finite differences of the residual,
+// is still owed). The parameter tau is shared (alefsi::gls_tau).
 // Pairs: any `ElementPair` whose `Stabilisation` is NoStabilisation or GlsStabilisation.
 //
 //     alefsi::testing::StokesQuadratureKernel<2, alefsi::P1P1Gls> ref(space, mu, force);

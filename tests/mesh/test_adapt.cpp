@@ -449,6 +449,12 @@ TEST_CASE("adapt and transfer: bad input names the parameter", "[mesh][adapt]") 
   opt = {};
   CHECK(param_of([&] { adapt(m, {Circle{Vec<2>::Zero(), -1.0, 1}}, opt); }) == "curves[0].radius");
   CHECK(param_of([&] { adapt(m, {Polyline{{Vec<2>(0, 0), Vec<2>(1, 0)}, 1}}, opt); }) == "curves[0].points");
+  {  // a tagged interior edge (an embedded sensor line) would be lost: refused, not dropped
+    const Mesh<2> square({Vec<2>(0, 0), Vec<2>(1, 0), Vec<2>(1, 1), Vec<2>(0, 1)}, {{0, 1, 2}, {0, 2, 3}}, {{0, 2}},
+                         {7});
+    REQUIRE(square.tagged_interior_facets().size() == 1);
+    CHECK(param_of([&] { adapt(square, {}, opt); }) == "moved");
+  }
 
   CHECK(param_of([&] { FieldTransfer2D(m, m, 3); }) == "degree");
   CHECK(param_of([&] { FieldTransfer2D(m, m, 1, std::vector<Vec<2>>(3)); }) == "to_edge_points");

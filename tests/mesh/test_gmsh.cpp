@@ -3,9 +3,12 @@
 // hand-written small files, and malformed files (tests/data/gmsh/README.md).
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <numbers>
+#include <numeric>
 #include <random>
 #include <set>
 #include <sstream>
@@ -331,9 +334,8 @@ TEST_CASE("gmsh: malformed files throw ParseError naming the problem and the lin
       {"mixed_order_v22.msh", 2, "mixes first- and second-order cells", 23},
       {"missing_physical_v22.msh", 2, "missing physical groups: no triangle belongs to a physical group", 22},
       {"missing_boundary_v41.msh", 2, "missing physical groups on the boundary", 31},
-      {"two_physical_groups_v41.msh", 2, "belongs to 2 physical groups (8, 9)", 7},
-      {"duplicate_triangle_v22.msh", 2, "this triangle repeats the one on line 22", 24},
-      {"duplicate_boundary_v22.msh", 2, "this boundary line repeats the one on line 18", 24},
+      {"duplicate_triangle_v22.msh", 2, "this triangle repeats the one on line 22 with the same physical tag 5", 24},
+      {"duplicate_boundary_v22.msh", 2, "this line repeats the one on line 18 with the same physical tag 1", 24},
       {"boundary_node_not_in_cell_v22.msh", 2, "uses node 5, which is not a vertex of any triangle", 25},
       {"nonplanar_v22.msh", 2, "not planar", 13},
       {"unsupported_version.msh", 2, "unsupported MSH format version 3.0 ASCII", 2},
@@ -367,9 +369,9 @@ TEST_CASE("gmsh: invalid meshes throw MeshError naming the cell or facet", "[mes
   // cell 1 = (0,0), (1,1), (0.5,0.5): collinear
   REQUIRE_THROWS_MATCHES(read_gmsh<2>(kDir + "bad/degenerate_cell_v22.msh"), MeshError,
                          MeshErrorIs(MeshError::Entity::cell, 1, "degenerate"));
-  // the diagonal of the square tagged as a boundary line: (D-1)-element 4 is interior
-  REQUIRE_THROWS_MATCHES(read_gmsh<2>(kDir + "bad/interior_facet_v22.msh"), MeshError,
-                         MeshErrorIs(MeshError::Entity::facet, 4, "not a boundary facet"));
+  // a tagged line from (1,0) to (0,1) crosses the square's diagonal: (D-1)-element 4 is no edge
+  REQUIRE_THROWS_MATCHES(read_gmsh<2>(kDir + "bad/not_a_facet_v22.msh"), MeshError,
+                         MeshErrorIs(MeshError::Entity::facet, 4, "not a facet of the mesh"));
   // and the message says which file, and the line of the element
   try {
     (void)read_gmsh<2>(kDir + "bad/degenerate_cell_v22.msh");
@@ -423,4 +425,139 @@ TEST_CASE("gmsh: truncated and corrupted files throw alefsi errors, never crash"
     }
   }
   CHECK(parse_errors > 0);
+}
+
+namespace {
+
+template <int D>
+Real facets_measure(const Mesh<D>& m, const std::vector<Index>& facets) {
+  Real s = 0;
+  for (Index f : facets) s += m.facet_measure(f);
+  return s;
+}
+
+template <int D>
+Real cells_measure(const Mesh<D>& m, const std::vector<Index>& cells) {
+  Real s = 0;
+  for (Index c : cells) s += m.measure(c);
+  return s;
+}
+
+/// Cell centroids, sorted: the same mesh read from files that number it differently.
+template <int D>
+std::vector<std::array<Real, D>> sorted_centroids(const Mesh<D>& m) {
+  std::vector<std::array<Real, D>> out;
+  for (Index c = 0; c < m.n_cells(); ++c) {
+    const Vec<D> g = m.centroid(c);
+    std::array<Real, D> a;
+    for (int k = 0; k < D; ++k) a[std::size_t(k)] = std::round(g[k] * 1e9) / 1e9;
+    out.push_back(a);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("gmsh: an entity in two physical groups is in both (gmsh t14)", "[mesh][gmsh][quick]") {
+  const auto g41 = read_gmsh<2>(kDir + "groups2d_msh41.msh");
+  const auto g22 = read_gmsh<2>(kDir + "groups2d_msh22.msh");  // writes each element once per group
+  require_same_mesh(g22, g41);
+  for (const auto* g : {&g41, &g22}) {
+    const Mesh<2>& m = g->mesh;
+    CHECK(g->cell_groups.size() == 2);
+    std::vector<Index> all(std::size_t(m.n_cells()));
+    std::iota(all.begin(), all.end(), Index(0));
+    CHECK(g->cell_groups.at(10) == all);
+    CHECK(g->cell_groups.at(11) == all);
+    for (Index c = 0; c < m.n_cells(); ++c) REQUIRE(m.cell_tag(c) == 10);  // the first group
+    CHECK(m.total_measure() == Approx(1.0).epsilon(1e-14));
+    // `walls` is the whole boundary, `bottom` its part y = 0, which keeps tag 1 (its first group)
+    CHECK(g->facet_groups.at(1).size() == m.boundary_facets().size());
+    CHECK(facets_measure(m, g->facet_groups.at(1)) == Approx(4.0).epsilon(1e-14));
+    CHECK(facets_measure(m, g->facet_groups.at(2)) == Approx(1.0).epsilon(1e-14));
+    for (Index f : g->facet_groups.at(2)) {
+      CHECK(m.on_boundary(f));
+      CHECK(m.facet_tag(f) == 1);
+      for (Index v : m.facet(f)) CHECK(m.node(v)[1] == 0.0);
+    }
+  }
+  // gmsh writes a negative physical tag for an entity in a group with reversed orientation
+  // (t14's `Physical Surface(80) = bnd()`): the group is 80
+  std::string text = slurp(kDir + "groups2d_msh41.msh");
+  const std::string bottom = "1 0 0 0 1 0 0 2 1 2 2 1 -2 \n";
+  REQUIRE(text.find(bottom) != std::string::npos);
+  text.replace(text.find(bottom), bottom.size(), "1 0 0 0 1 0 0 2 -1 -2 2 1 -2 \n");
+  std::istringstream in(text);
+  const auto neg = read_gmsh<2>(in, "negative tags");
+  CHECK(neg.facet_groups.at(1) == g41.facet_groups.at(1));
+  CHECK(neg.facet_groups.at(2) == g41.facet_groups.at(2));
+  CHECK(neg.facet_groups.count(-2) == 0);
+}
+
+TEST_CASE("gmsh: embedded curves and surfaces are tagged interior facets (gmsh t15)", "[mesh][gmsh][quick]") {
+  {  // 2D: the sensor line y = 0.5, 0.25 <= x <= 0.75
+    const auto g = read_gmsh<2>(kDir + "groups2d_msh41.msh");
+    const Mesh<2>& m = g.mesh;
+    const auto inner = m.tagged_interior_facets();
+    CHECK(inner == g.facet_groups.at(5));
+    CHECK(facets_measure(m, inner) == Approx(0.5).epsilon(1e-14));
+    for (Index f : inner) {
+      CHECK_FALSE(m.on_boundary(f));
+      CHECK(m.facet_tag(f) == 5);
+      for (Index v : m.facet(f)) CHECK(m.node(v)[1] == 0.5);
+    }
+    for (Index f : m.boundary_facets()) REQUIRE(m.facet_tag(f) == 1);
+    CHECK(m.boundary_nodes(5).empty());  // boundary queries see boundary facets only
+  }
+  for (const char* name : {"embedded3d_msh41.msh", "embedded3d_msh22.msh"}) {
+    CAPTURE(name);
+    const auto g = read_gmsh<3>(kDir + name);
+    const Mesh<3>& m = g.mesh;
+    const auto inner = m.tagged_interior_facets();
+    REQUIRE(inner.size() >= 2);
+    CHECK(inner == g.facet_groups.at(7));
+    CHECK(facets_measure(m, inner) == Approx(0.25).epsilon(1e-12));
+    for (Index f : inner) {
+      CHECK(m.facet_tag(f) == 7);
+      for (Index v : m.facet(f)) {
+        CHECK(m.node(v)[2] == Approx(0.5).epsilon(1e-14));
+        CHECK(std::max(std::abs(m.node(v)[0] - 0.5), std::abs(m.node(v)[1] - 0.5)) <= 0.25 + 1e-12);
+      }
+    }
+    CHECK(boundary_measure(m, 1) == Approx(6.0).epsilon(1e-12));
+    CHECK(m.total_measure() == Approx(1.0).epsilon(1e-12));
+  }
+}
+
+TEST_CASE("gmsh: partitioned MSH 4.1 files read as the whole mesh with each cell's partition (gmsh t21)",
+          "[mesh][gmsh][quick]") {
+  const auto plain = read_gmsh<2>(kDir + "channel2d_o1_msh41.msh");
+  CHECK(plain.n_partitions == 0);
+  CHECK(plain.cell_partitions.empty());
+  for (const char* name :
+       {"channel2d_part3_msh41.msh", "channel2d_part3_msh41bin.msh", "channel2d_part3_ghosts_msh41.msh"}) {
+    CAPTURE(name);
+    const auto g = read_gmsh<2>(kDir + name);
+    const Mesh<2>& m = g.mesh;
+    // the same mesh, numbered partition by partition; ghost cells are not read twice
+    REQUIRE(m.n_nodes() == plain.mesh.n_nodes());
+    REQUIRE(m.n_cells() == plain.mesh.n_cells());
+    CHECK(sorted_centroids(m) == sorted_centroids(plain.mesh));
+    for (int tag : {10, 11}) CHECK(region_measure(m, tag) == Approx(region_measure(plain.mesh, tag)).epsilon(1e-14));
+    for (int tag : {1, 2, 3, 4})
+      CHECK(boundary_measure(m, tag) == Approx(boundary_measure(plain.mesh, tag)).epsilon(1e-14));
+    // the partition interfaces' lines are not kept: no tagged interior facet
+    CHECK(m.tagged_interior_facets().empty());
+    // three partitions, each a nonempty set of cells
+    CHECK(g.n_partitions == 3);
+    REQUIRE(g.cell_partitions.size() == std::size_t(m.n_cells()));
+    std::array<int, 3> count{};
+    for (int p : g.cell_partitions) {
+      REQUIRE(p >= 1);
+      REQUIRE(p <= 3);
+      ++count[std::size_t(p - 1)];
+    }
+    for (int n : count) CHECK(n > m.n_cells() / 6);
+  }
 }

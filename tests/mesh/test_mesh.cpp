@@ -141,8 +141,16 @@ TEST_CASE("invalid meshes are rejected with the offending entity named", "[mesh]
     std::vector<Vec<2>> z{Vec<2>(0, 0), Vec<2>(1, 0), Vec<2>(0.5, 1), Vec<2>(0.5, 2), Vec<2>(0.5, -1)};
     REQUIRE_THROWS_WITH((Mesh<2>(z, {{0, 1, 2}, {0, 1, 3}, {1, 0, 4}})), Contains("non-manifold"));
   }
-  SECTION("tagged facet that is not on the boundary") {
-    REQUIRE_THROWS_AS((Mesh<2>(x, {{0, 1, 2}, {0, 2, 3}}, {{0, 2}}, {7})), MeshError);
+  SECTION("tagged facet that is not a facet of the mesh") {
+    // (1, 3) crosses the diagonal (0, 2); a tagged interior facet such as (0, 2) is fine
+    REQUIRE_THROWS_WITH((Mesh<2>(x, {{0, 1, 2}, {0, 2, 3}}, {{1, 3}}, {7})), Contains("not a facet of the mesh"));
+    const Mesh<2> m(x, {{0, 1, 2}, {0, 2, 3}}, {{2, 0}}, {7});
+    REQUIRE(m.tagged_interior_facets().size() == 1);
+    const Index f = m.tagged_interior_facets()[0];
+    CHECK(m.facet(f) == Mesh<2>::Facet{0, 2});
+    CHECK(m.facet_tag(f) == 7);
+    CHECK_FALSE(m.on_boundary(f));
+    for (Index b : m.boundary_facets()) CHECK(m.facet_tag(b) == 0);
   }
   SECTION("moving a node through a cell inverts it: refused, mesh unchanged") {
     Mesh<2> m(x, {{0, 1, 2}, {0, 2, 3}});

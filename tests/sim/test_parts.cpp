@@ -370,3 +370,26 @@ TEST_CASE("FlowState: write_state / read_state round trip, and a mismatched body
   CHECK_THROWS_WITH(read_state(rd, wrong, {8}, 7), Catch::Contains("body tags"));
   std::filesystem::remove(file);
 }
+
+TEST_CASE("checkpoint mesh: boundary and interior facet tags round-trip", "[sim][checkpoint][quick]") {
+  const auto g = read_gmsh<2>(ALEFSI_TEST_DATA_DIR "/gmsh/groups2d_msh41.msh");  // an embedded sensor line
+  REQUIRE(!g.mesh.tagged_interior_facets().empty());
+  const auto file = std::filesystem::temp_directory_path() / "alefsi_test_mesh.bin";
+  {
+    CheckpointWriter w(file);
+    write_mesh(w, g.mesh);
+    w.commit();
+  }
+  CheckpointReader rd(file);
+  const Mesh<2> m = read_mesh<2>(rd);
+  rd.finish();
+  std::filesystem::remove(file);
+  REQUIRE(m.n_facets() == g.mesh.n_facets());
+  CHECK(m.cells() == g.mesh.cells());
+  CHECK(m.cell_tags() == g.mesh.cell_tags());
+  for (Index f = 0; f < m.n_facets(); ++f) {
+    REQUIRE(m.facet(f) == g.mesh.facet(f));
+    REQUIRE(m.facet_tag(f) == g.mesh.facet_tag(f));
+  }
+  CHECK(m.tagged_interior_facets() == g.mesh.tagged_interior_facets());
+}

@@ -3,12 +3,14 @@
 /// Conforming simplex meshes in 2D (triangles) and 3D (tetrahedra).
 ///
 /// A `Mesh<D>` owns node coordinates, cells (D+1 node indices, positively oriented),
-/// an integer region tag per cell and tagged boundary facets. On construction it checks
+/// an integer region tag per cell and tagged facets: boundary facets carry the tags boundary
+/// conditions and bodies refer to; interior facets may carry tags too (an embedded surface
+/// for output or sensors; nothing in the solver reads them). On construction it checks
 /// that the mesh is valid and builds its topology: unique edges, unique facets, the cells
 /// on each side of a facet, and the edges and facets of each cell in the local order of
 /// `SimplexTopology<D>`. Invalid input throws `MeshError` naming the offending entity:
 /// out-of-range node index, degenerate or inverted cell, dangling (unused) node,
-/// non-manifold facet (shared by more than two cells), tagged facet that is not on the boundary.
+/// non-manifold facet (shared by more than two cells), tagged facet that is not a facet of the mesh.
 ///
 /// Coordinates may change (moving meshes) through `set_coordinates`, which rechecks the
 /// orientation of every cell; the topology stays.
@@ -47,23 +49,24 @@ class Mesh {
 
   Mesh() = default;
 
-  /// Builds and validates a mesh. `boundary_facets[i]` (any vertex order) gets tag
-  /// `boundary_tags[i]`; boundary facets not listed get tag 0. `cell_tags` may be empty (all 0).
+  /// Builds and validates a mesh. `tagged_facets[i]` (any vertex order; a boundary or an
+  /// interior facet) gets tag `facet_tags[i]`; facets not listed get tag 0. `cell_tags` may be
+  /// empty (all 0).
   Mesh(std::vector<Point> nodes, std::vector<Cell> cells,
-       const std::vector<Facet>& boundary_facets = {}, const std::vector<int>& boundary_tags = {},
+       const std::vector<Facet>& tagged_facets = {}, const std::vector<int>& facet_tags = {},
        std::vector<int> cell_tags = {})
       : x_(std::move(nodes)), cells_(std::move(cells)), cell_tags_(std::move(cell_tags)) {
     if (cell_tags_.empty()) cell_tags_.assign(cells_.size(), 0);
     if (cell_tags_.size() != cells_.size())
       throw MeshError(MeshError::Entity::mesh, -1, "cell_tags has " + std::to_string(cell_tags_.size()) +
                                                        " entries for " + std::to_string(cells_.size()) + " cells");
-    if (boundary_facets.size() != boundary_tags.size())
-      throw MeshError(MeshError::Entity::mesh, -1, "boundary_facets and boundary_tags differ in size");
+    if (tagged_facets.size() != facet_tags.size())
+      throw MeshError(MeshError::Entity::mesh, -1, "tagged_facets and facet_tags differ in size");
     if (cells_.empty()) throw MeshError(MeshError::Entity::mesh, -1, "no cells");
     check_cells();
     build_edges();
     build_facets();
-    tag_boundary(boundary_facets, boundary_tags);
+    tag_facets(tagged_facets, facet_tags);
   }
 
   // --- sizes -------------------------------------------------------------------------
@@ -89,10 +92,17 @@ class Mesh {
   /// Global facet indices of cell c; local facet i is opposite local vertex i.
   const std::array<Index, nf>& cell_facets(Index c) const { return cell_facets_[c]; }
   bool on_boundary(Index f) const { return facet_cells_[f][1] < 0; }
-  /// Physical tag of a boundary facet (0 if untagged or interior).
+  /// Physical tag of a facet (0 if untagged).
   int facet_tag(Index f) const { return facet_tags_[f]; }
   /// Indices of all boundary facets.
   const std::vector<Index>& boundary_facets() const { return boundary_facets_; }
+  /// Indices of the interior facets with a nonzero tag (an embedded curve or surface).
+  std::vector<Index> tagged_interior_facets() const {
+    std::vector<Index> out;
+    for (Index f = 0; f < n_facets(); ++f)
+      if (facet_tags_[f] != 0 && !on_boundary(f)) out.push_back(f);
+    return out;
+  }
 
   /// Sorted, unique nodes on boundary facets with the given tag.
   std::vector<Index> boundary_nodes(int tag) const {
@@ -301,24 +311,24 @@ class Mesh {
       if (facet_cells_[f][1] < 0) boundary_facets_.push_back(f);
   }
 
-  void tag_boundary(const std::vector<Facet>& bf, const std::vector<int>& tags) {
+  void tag_facets(const std::vector<Facet>& bf, const std::vector<int>& tags) {
     if (bf.empty()) return;
-    // index boundary facets by smallest vertex
+    // index facets by smallest vertex
     std::vector<std::vector<Index>> by_node(x_.size());
-    for (Index f : boundary_facets_) by_node[facets_[f][0]].push_back(f);
+    for (Index f = 0; f < n_facets(); ++f) by_node[facets_[f][0]].push_back(f);
     for (std::size_t i = 0; i < bf.size(); ++i) {
       Facet k = bf[i];
       for (Index v : k)
         if (v < 0 || v >= n_nodes())
           throw MeshError(MeshError::Entity::facet, static_cast<Index>(i),
-                          "tagged boundary facet has node index " + std::to_string(v) + " out of range");
+                          "tagged facet has node index " + std::to_string(v) + " out of range");
       std::sort(k.begin(), k.end());
       Index found = -1;
       for (Index f : by_node[k[0]])
         if (facets_[f] == k) found = f;
       if (found < 0)
         throw MeshError(MeshError::Entity::facet, static_cast<Index>(i),
-                        "tagged facet (tag " + std::to_string(tags[i]) + ") is not a boundary facet of the mesh");
+                        "tagged facet (tag " + std::to_string(tags[i]) + ") is not a facet of the mesh");
       facet_tags_[found] = tags[i];
     }
   }

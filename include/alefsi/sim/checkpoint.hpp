@@ -298,6 +298,7 @@ void write_mesh(CheckpointWriter& w, const Mesh<D>& m) {
   std::vector<typename Mesh<D>::Facet> facets;
   std::vector<int> tags;
   for (Index f : m.boundary_facets()) facets.push_back(m.facet(f)), tags.push_back(m.facet_tag(f));
+  for (Index f : m.tagged_interior_facets()) facets.push_back(m.facet(f)), tags.push_back(m.facet_tag(f));
   w.put_vector(facets);
   w.put_vector(tags);
 }

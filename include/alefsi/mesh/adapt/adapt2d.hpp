@@ -612,6 +612,11 @@ class AdaptMesh2D {
 
 inline void validate_adapt(const Mesh<2>& moved, const std::vector<BoundaryCurve>& curves, const AdaptOptions& opt) {
   ALEFSI_CHECK_ARG(moved.n_cells() > 0, "moved", "empty mesh");
+  // the operators know boundary curves only: an embedded (tagged interior) edge would be lost
+  if (const auto embedded = moved.tagged_interior_facets(); !embedded.empty())
+    ALEFSI_CHECK_ARG(false, "moved", "has ", embedded.size(), " tagged interior edges (the first: facet ",
+                     embedded.front(), ", tag ", moved.facet_tag(embedded.front()),
+                     "); adaptation keeps boundary tags only and would drop them");
   ALEFSI_CHECK_ARG(opt.tolerance > 0 && opt.tolerance <= 10, "tolerance", "must be in (0, 10], got ", opt.tolerance);
   ALEFSI_CHECK_ARG(opt.min_quality >= 0 && opt.min_quality < 1, "min_quality", "must be in [0, 1), got ", opt.min_quality);
   ALEFSI_CHECK_ARG(opt.smoothing_sweeps >= 0, "smoothing_sweeps", "must be >= 0, got ", opt.smoothing_sweeps);

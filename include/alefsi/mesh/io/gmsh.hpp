@@ -9,11 +9,20 @@
 ///   - boundary: elements of dimension D-1 (lines 1 / 8 in 2D, triangles 2 / 9 in 3D) become
 ///     tagged boundary facets carrying their physical tag (`Mesh::facet_tag`);
 ///   - points, and lines in 3D, are ignored; any other element type is an error.
-/// Every cell and every (D-1)-element must belong to exactly one physical group (in the .geo:
+/// Every cell and every (D-1)-element must belong to a physical group (in the .geo:
 /// `Physical Surface` / `Physical Volume` for the cells, `Physical Curve` / `Physical Surface`
-/// for the boundary). Physical tags come from `$Entities` in MSH 4.1 and from the first element
-/// tag in MSH 2.2. `physical_names` maps the tags of the D- and (D-1)-dimensional physical
-/// groups to their names from `$PhysicalNames`.
+/// for the facets). Physical tags come from `$Entities` (or `$PartitionedEntities`) in MSH 4.1
+/// and from the first element tag in MSH 2.2. `physical_names` maps the tags of the D- and
+/// (D-1)-dimensional physical groups to their names from `$PhysicalNames`.
+///   - An element in several groups (MSH 4.1: its entity lists several tags; MSH 2.2: the
+///     element is written once per group) gets its first group as its tag; `cell_groups` and
+///     `facet_groups` list every group's elements. A negative tag in `$Entities` is the group
+///     |tag| (the entity with reversed orientation). A repeat with a tag the element already
+///     has is an error.
+///   - (D-1)-elements inside the domain (embedded curves / surfaces) are tagged interior facets.
+///   - Partitioned MSH 4.1 files are read whole; `cell_partitions` gives each cell's partition.
+///     Elements of ghost entities and of partition interfaces (entities whose parent model
+///     entity is D-dimensional) are skipped.
 ///
 /// Conventions:
 ///   - Nodes no cell uses as a vertex (gmsh writes geometry points, mid nodes, ...) are dropped;
@@ -32,7 +41,7 @@
 /// Errors: a malformed file throws ParseError(file, line, message) with the 1-based line of the
 /// offending line (inside a binary block: the line where that block starts; line 0 when the
 /// file cannot be opened). An invalid mesh (degenerate cell, a tagged (D-1)-element that is
-/// not on the boundary, ...) throws the Mesh constructor's MeshError (entity and index as it
+/// not a facet of the cells, ...) throws the Mesh constructor's MeshError (entity and index as it
 /// gives them), its message led by the file and the line of the offending element.
 ///
 ///     auto g = alefsi::read_gmsh<2>("channel.msh");   // gmsh -2 channel.geo -format msh41
@@ -50,6 +59,7 @@
 #include <map>
 #include <numeric>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -71,6 +81,17 @@ struct GmshMesh {
   /// For second-order files (triangle6 / tet10): coordinates of each mesh edge's mid node,
   /// indexed by mesh edge index (mesh.edge(e)); empty for first-order files.
   std::vector<Vec<D>> edge_midpoints;
+  /// Physical group of dimension D -> its cells (sorted indices). A cell in several groups is
+  /// in each; its `mesh.cell_tag` is the first (in MSH 4.1 the first its entity lists, in MSH
+  /// 2.2 its first copy in the file).
+  std::map<int, std::vector<Index>> cell_groups;
+  /// Physical group of dimension D-1 -> its facets (sorted mesh facet indices), boundary or
+  /// interior; `mesh.facet_tag` is the first group of a facet in several.
+  std::map<int, std::vector<Index>> facet_groups;
+  /// Partitioned MSH 4.1 files ($PartitionedEntities): the number of partitions and each
+  /// cell's partition (1-based, as gmsh numbers them); 0 and empty otherwise.
+  int n_partitions = 0;
+  std::vector<int> cell_partitions;
 };
 
 namespace detail {
@@ -414,10 +435,9 @@ class GmshReader {
   static constexpr const char* facet_group = D == 2 ? "Physical Curve" : "Physical Surface";
 
   struct Entity {
-    int phys = 0;     // first physical tag (0: none)
-    std::int64_t n_phys = 0;
-    int second = 0;   // second physical tag, for the error message
-    std::size_t line = 0;
+    std::vector<int> phys;  // physical tags in file order (the first is the element's tag)
+    int partition = 0;      // partitioned entity: its first partition (0: not partitioned)
+    int parent_dim = -1;    // partitioned entity: dimension of the model entity it comes from
   };
   enum class Kind { cell, facet, ignore };
 
@@ -443,6 +463,10 @@ class GmshReader {
       } else if (name == "Entities" && v41_) {
         once(have_entities_, name, line);
         parse_entities();
+      } else if (name == "PartitionedEntities" && v41_) {
+        once(have_partitions_, name, line);
+        if (have_nodes_ || have_elements_) cur_.fail(line, "$PartitionedEntities must come before $Nodes and $Elements");
+        parse_partitioned_entities();
       } else if (name == "Nodes") {
         once(have_nodes_, name, line);
         if (v41_) parse_nodes41();
@@ -547,21 +571,82 @@ class GmshReader {
         for (int k = 0; k < (d == 0 ? 3 : 6); ++k)
           cur_.read_real(d == 0 ? "point coordinate" : "bounding box coordinate");
         Entity e;
-        e.line = cur_.record_line();
-        const std::int64_t np = cur_.read_count("number of physical tags", 2, 4);
-        e.n_phys = np;
-        for (std::int64_t k = 0; k < np; ++k) {
-          const int p = cur_.read_int("physical tag");
-          if (k == 0) e.phys = p;
-          if (k == 1) e.second = p;
+        read_entity_tail(d, e);
+        add_entity(d, tag, std::move(e));
+      }
+    }
+    cur_.expect_end();
+  }
+
+  /// The physical tags and bounding entities that end an entity record of dimension d.
+  void read_entity_tail(int d, Entity& e) {
+    const std::int64_t np = cur_.read_count("number of physical tags", 2, 4);
+    e.phys.resize(std::size_t(np));
+    // a negative tag is the group |tag| holding the entity with reversed orientation (gmsh t14)
+    for (auto& p : e.phys) {
+      p = cur_.read_int("physical tag");
+      if (p == std::numeric_limits<int>::min()) cur_.fail("physical tag " + std::to_string(p) + " is out of range");
+      p = std::abs(p);
+    }
+    if (d > 0) {
+      const std::int64_t nb = cur_.read_count("number of bounding entities", 2, 4);
+      for (std::int64_t k = 0; k < nb; ++k) cur_.read_int("bounding entity tag");
+    }
+    cur_.end_record("entity");
+  }
+
+  void add_entity(int d, int tag, Entity e) {
+    if (!entities_[std::size_t(d)].emplace(tag, std::move(e)).second)
+      cur_.fail("duplicate entity tag " + std::to_string(tag) + " of dimension " + std::to_string(d));
+  }
+
+  /// $PartitionedEntities (MSH 4.1, written by gmsh's partitioner): the entities the element
+  /// blocks of a partitioned file refer to, each with its partitions and physical tags; the
+  /// ghost entities, whose elements copy those of neighbouring partitions.
+  void parse_partitioned_entities() {
+    if (cur_.binary()) cur_.end_marker_line();
+    cur_.begin_block();
+    cur_.begin_record();
+    const std::int64_t np = cur_.read_size("number of partitions");
+    if (np < 1 || np > std::numeric_limits<int>::max())
+      cur_.fail("number of partitions " + std::to_string(np) + " is not in [1, 2^31)");
+    n_partitions_ = int(np);
+    cur_.end_record("number of partitions");
+    cur_.begin_record();
+    const std::int64_t ng = cur_.read_count("number of ghost entities", 4, 8);
+    cur_.end_record("number of ghost entities");
+    for (std::int64_t i = 0; i < ng; ++i) {
+      cur_.begin_record();
+      ghosts_.insert(cur_.read_int("ghost entity tag"));
+      cur_.read_int("ghost entity partition");
+      cur_.end_record("ghost entity");
+    }
+    cur_.begin_record();
+    std::array<std::int64_t, 4> count{};
+    for (int d = 0; d < 4; ++d)
+      count[d] = cur_.read_count(d == 0 ? "number of points" : d == 1 ? "number of curves"
+                                        : d == 2             ? "number of surfaces"
+                                                             : "number of volumes",
+                                 d == 0 ? 16 : 24, d == 0 ? 52 : 84);
+    cur_.end_record("$PartitionedEntities count");
+    for (int d = 0; d < 4; ++d) {
+      for (std::int64_t i = 0; i < count[d]; ++i) {
+        cur_.begin_record();
+        const int tag = cur_.read_int("entity tag");
+        Entity e;
+        e.parent_dim = cur_.read_int("parent dimension");
+        cur_.read_int("parent tag");
+        const std::int64_t nparts = cur_.read_count("number of partitions of the entity", 2, 4);
+        for (std::int64_t k = 0; k < nparts; ++k) {
+          const int part = cur_.read_int("partition tag");
+          if (part < 1 || part > n_partitions_)
+            cur_.fail("partition tag " + std::to_string(part) + " is not in [1, " + std::to_string(n_partitions_) + "]");
+          if (k == 0) e.partition = part;
         }
-        if (d > 0) {
-          const std::int64_t nb = cur_.read_count("number of bounding entities", 2, 4);
-          for (std::int64_t k = 0; k < nb; ++k) cur_.read_int("bounding entity tag");
-        }
-        cur_.end_record("entity");
-        if (!entities_[d].emplace(tag, e).second)
-          cur_.fail("duplicate entity tag " + std::to_string(tag) + " of dimension " + std::to_string(d));
+        for (int k = 0; k < (d == 0 ? 3 : 6); ++k)
+          cur_.read_real(d == 0 ? "point coordinate" : "bounding box coordinate");
+        read_entity_tail(d, e);
+        add_entity(d, tag, std::move(e));
       }
     }
     cur_.expect_end();
@@ -738,7 +823,7 @@ class GmshReader {
       const int dim = cur_.read_int("entity dimension");
       const int entity = cur_.read_int("entity tag");
       const int type = cur_.read_int("element type");
-      const Kind kind = classify(type);
+      Kind kind = classify(type);
       const int nn = gmsh_element_type(type)->nodes;
       const std::int64_t n = cur_.read_count("number of elements in the block", std::size_t(2 * (nn + 1)),
                                              std::size_t(8 * (nn + 1)));
@@ -751,13 +836,24 @@ class GmshReader {
         cur_.fail("the element blocks hold more elements than the " + std::to_string(total) + " announced on line " +
                   std::to_string(header) + " (count mismatch)");
       seen += n;
-      const int phys = kind == Kind::ignore ? 0 : physical_tag(dim, entity, block_line);
+      const Entity* e = kind == Kind::ignore ? nullptr : find_entity(dim, entity, block_line);
+      // a partitioned file's ghost cells copy cells of other partitions, and the facets of its
+      // partition interfaces (entities that come from a D-dimensional model entity) are interior
+      // facets of the model that no physical group asked for
+      if (e && ((kind == Kind::cell && ghosts_.count(entity)) || (kind == Kind::facet && e->parent_dim == D)))
+        kind = Kind::ignore, e = nullptr;
       for (std::int64_t i = 0; i < n; ++i) {
         cur_.begin_record();
         cur_.read_size("element tag");
         for (int k = 0; k < nn; ++k) nodes[std::size_t(k)] = cur_.read_size("node tag");
         cur_.end_record("element");
-        if (kind != Kind::ignore) add_element(kind, type, nodes.data(), phys, cur_.record_line());
+        if (kind == Kind::ignore) continue;
+        add_element(kind, type, nodes.data(), e && !e->phys.empty() ? e->phys[0] : 0, cur_.record_line());
+        if (!e) continue;
+        auto& extra = kind == Kind::cell ? cell_extra_ : facet_extra_;
+        const std::size_t index = (kind == Kind::cell ? cell_line_ : facet_line_).size() - 1;
+        for (std::size_t k = 1; k < e->phys.size(); ++k) extra.emplace_back(index, e->phys[k]);
+        if (kind == Kind::cell && have_partitions_) cell_part_.push_back(e->partition);
       }
     }
     if (seen != total)
@@ -766,20 +862,16 @@ class GmshReader {
     cur_.expect_end();
   }
 
-  /// Physical tag of the entity (dim, tag) of an element block (MSH 4.1); 0 if none.
-  int physical_tag(int dim, int entity, std::size_t block_line) {
-    if (!have_entities_) return 0;
+  /// The entity (dim, tag) of an element block (MSH 4.1); nullptr for a file without $Entities.
+  const Entity* find_entity(int dim, int entity, std::size_t block_line) {
+    if (!have_entities_ && !have_partitions_) return nullptr;
     const auto it = entities_[std::size_t(dim)].find(entity);
     if (it == entities_[std::size_t(dim)].end())
       cur_.fail(block_line, "element block refers to entity " + std::to_string(entity) + " of dimension " +
-                                std::to_string(dim) + ", which $Entities does not list");
-    const Entity& e = it->second;
-    if (e.n_phys > 1)
-      cur_.fail(e.line, "entity " + std::to_string(entity) + " of dimension " + std::to_string(dim) + " belongs to " +
-                            std::to_string(e.n_phys) + " physical groups (" + std::to_string(e.phys) + ", " +
-                            std::to_string(e.second) + (e.n_phys > 2 ? ", ..." : "") +
-                            "); alefsi needs exactly one physical tag per cell and boundary facet");
-    return e.phys;
+                                std::to_string(dim) + ", which " +
+                                (have_partitions_ ? "neither $Entities nor $PartitionedEntities lists"
+                                                  : "$Entities does not list"));
+    return &it->second;
   }
 
   // --- building the mesh -----------------------------------------------------------------
@@ -827,45 +919,64 @@ class GmshReader {
     std::vector<std::pair<std::int64_t, Index>> sorted_;
   };
 
-  /// Reports the first (in file order) element whose sorted vertices repeat an earlier one's.
+  /// Elements whose sorted vertices repeat an earlier one's. MSH 2.2 writes an element once
+  /// per physical group it belongs to: a repeat with another physical tag is merged into its
+  /// first copy (its tag joins `extra`); a repeat with a tag the element already has is an
+  /// error (the first such in file order is reported). Returns, per element, its first copy.
   template <int K>
-  void check_duplicates(const std::vector<std::array<Index, K>>& items, const std::vector<std::size_t>& lines,
-                        const std::string& word) {
+  std::vector<std::size_t> find_repeats(const std::vector<std::array<Index, K>>& items, const std::vector<int>& phys,
+                                        const std::vector<std::size_t>& lines, const std::string& word,
+                                        std::vector<std::pair<std::size_t, int>>& extra) {
     std::vector<std::array<Index, K>> keys(items);
     for (auto& k : keys) std::sort(k.begin(), k.end());
-    std::vector<Index> order(items.size());
-    std::iota(order.begin(), order.end(), Index(0));
+    std::vector<std::size_t> order(items.size()), first(items.size());
+    std::iota(order.begin(), order.end(), std::size_t(0));
+    std::iota(first.begin(), first.end(), std::size_t(0));
     std::sort(order.begin(), order.end(),
-              [&](Index a, Index b) { return keys[a] != keys[b] ? keys[a] < keys[b] : a < b; });
-    std::size_t again = items.size(), first = 0;
-    for (std::size_t k = 1, run = 0; k < order.size(); ++k) {
-      if (keys[order[k]] != keys[order[k - 1]]) run = k;
-      else if (std::size_t(order[k]) < again)
-        again = std::size_t(order[k]), first = std::size_t(order[run]);
+              [&](std::size_t a, std::size_t b) { return keys[a] != keys[b] ? keys[a] < keys[b] : a < b; });
+    std::size_t again = items.size(), again_first = 0;
+    std::vector<int> run_tags;
+    for (std::size_t k = 0, run = 0; k < order.size(); ++k) {
+      const std::size_t i = order[k];
+      if (k == 0 || keys[i] != keys[order[k - 1]]) {
+        run = k;
+        run_tags.assign(1, phys[i]);
+        continue;
+      }
+      first[i] = order[run];
+      if (std::find(run_tags.begin(), run_tags.end(), phys[i]) != run_tags.end()) {
+        if (i < again) again = i, again_first = order[run];
+      } else {
+        run_tags.push_back(phys[i]);
+        extra.emplace_back(order[run], phys[i]);
+      }
     }
     if (again < items.size())
-      cur_.fail(lines[again], "this " + word + " repeats the one on line " + std::to_string(lines[first]) +
-                                  " (gmsh writes an element once per physical group it belongs to; put each " +
-                                  word + " in exactly one physical group)");
+      cur_.fail(lines[again], "this " + word + " repeats the one on line " + std::to_string(lines[again_first]) +
+                                  " with the same physical tag " + std::to_string(phys[again]));
+    return first;
   }
 
-  /// A repeated cell shares all its facets with its copy; on a valid Mesh (at most two cells
-  /// per facet) comparing each cell with its neighbour across local facet 0 finds them in O(n).
-  void check_duplicate_cells(const Mesh<D>& mesh) {
-    auto sorted = [&](Index c) {
-      auto k = mesh.cell(c);
-      std::sort(k.begin(), k.end());
-      return k;
-    };
-    for (Index c = 0; c < mesh.n_cells(); ++c) {
-      const auto& fc = mesh.facet_cells(mesh.cell_facets(c)[0]);
-      const Index other = fc[0] == c ? fc[1] : fc[0];
-      if (other >= 0 && other < c && sorted(other) == sorted(c))
-        cur_.fail(cell_line_[std::size_t(c)], std::string("this ") + cell_word + " repeats the one on line " +
-                                                  std::to_string(cell_line_[std::size_t(other)]) +
-                                                  " (gmsh writes an element once per physical group it belongs to; "
-                                                  "put each " + cell_word + " in exactly one physical group)");
-    }
+  /// Keeps the entries of `v` (`per` consecutive ones per element; none: nothing to do)
+  /// whose element is its own first copy.
+  template <class T>
+  static void keep_firsts(std::vector<T>& v, const std::vector<std::size_t>& first, std::size_t per = 1) {
+    if (v.empty()) return;
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < first.size(); ++i)
+      if (first[i] == i) {
+        for (std::size_t k = 0; k < per; ++k) v[per * n + k] = v[per * i + k];
+        ++n;
+      }
+    v.resize(per * n);
+  }
+
+  /// New index of each kept element (its first copy's rank among the kept ones).
+  static std::vector<std::size_t> kept_index(const std::vector<std::size_t>& first) {
+    std::vector<std::size_t> out(first.size());
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < first.size(); ++i) out[i] = first[i] == i ? n++ : out[first[i]];
+    return out;
   }
 
   GmshMesh<D> build() {
@@ -881,7 +992,8 @@ class GmshReader {
     // resolve node tags
     const int cn = gmsh_element_type(cell_type_)->nodes;
     const bool order2 = cn > nv;
-    const std::size_t nc = cell_line_.size(), nf = facet_line_.size();
+    std::size_t nc = cell_line_.size();
+    const std::size_t nf = facet_line_.size();
     if (std::max(nc, nf) > std::size_t(std::numeric_limits<Index>::max()))
       cur_.fail(elements_line_, "too many elements (" + std::to_string(std::max(nc, nf)) + ")");
     std::vector<Index> cell_idx(cell_nodes_.size());
@@ -951,13 +1063,24 @@ class GmshReader {
                                         ", which is not a vertex of any " + cell_word);
         facets[f][std::size_t(k)] = v;
       }
-    check_duplicates<D>(facets, facet_line_, std::string("boundary ") + facet_word);
+
+    // repeated elements (MSH 2.2 writes an element once per physical group) join their first copy
+    const auto ffirst = find_repeats<D>(facets, facet_phys_, facet_line_, facet_word, facet_extra_);
+    const auto cfirst = find_repeats<nv>(cells, cell_phys_, cell_line_, cell_word, cell_extra_);
+    {
+      const auto fnew = kept_index(ffirst), cnew = kept_index(cfirst);
+      for (auto& [f, tag] : facet_extra_) f = fnew[f];
+      for (auto& [c, tag] : cell_extra_) c = cnew[c];
+    }
+    keep_firsts(facets, ffirst), keep_firsts(facet_phys_, ffirst), keep_firsts(facet_line_, ffirst);
+    keep_firsts(cells, cfirst), keep_firsts(swapped, cfirst), keep_firsts(cell_line_, cfirst);
+    keep_firsts(cell_phys_, cfirst), keep_firsts(cell_part_, cfirst), keep_firsts(cell_idx, cfirst, std::size_t(cn));
+    nc = cells.size();
 
     GmshMesh<D> out;
     try {
-      out.mesh = Mesh<D>(std::move(x), cells, facets, facet_phys_, std::move(cell_phys_));
+      out.mesh = Mesh<D>(std::move(x), cells, facets, facet_phys_, cell_phys_);
     } catch (const MeshError& e) {
-      check_duplicates<nv>(cells, cell_line_, cell_word);  // a clearer diagnosis if it applies
       // the same error, located: the file and the line of the offending element
       const std::vector<std::size_t>* lines = e.entity() == MeshError::Entity::cell    ? &cell_line_
                                               : e.entity() == MeshError::Entity::facet ? &facet_line_
@@ -965,8 +1088,19 @@ class GmshReader {
       const bool known = lines && e.index() >= 0 && std::size_t(e.index()) < lines->size();
       throw e.located(cur_.file() + (known ? ":" + std::to_string((*lines)[std::size_t(e.index())]) : std::string()));
     }
-    check_duplicate_cells(out.mesh);
     out.physical_names = std::move(names_);
+    for (std::size_t c = 0; c < nc; ++c) out.cell_groups[cell_phys_[c]].push_back(Index(c));
+    for (const auto& [c, tag] : cell_extra_) out.cell_groups[tag].push_back(Index(c));
+    const std::vector<Index> mesh_facet = facet_indices(out.mesh, facets);
+    for (std::size_t f = 0; f < facets.size(); ++f) out.facet_groups[facet_phys_[f]].push_back(mesh_facet[f]);
+    for (const auto& [f, tag] : facet_extra_) out.facet_groups[tag].push_back(mesh_facet[f]);
+    for (auto* groups : {&out.cell_groups, &out.facet_groups})
+      for (auto& [tag, items] : *groups) {
+        std::sort(items.begin(), items.end());
+        items.erase(std::unique(items.begin(), items.end()), items.end());
+      }
+    out.n_partitions = n_partitions_;
+    out.cell_partitions = std::move(cell_part_);
 
     if (order2) {
       const Mesh<D>& mesh = out.mesh;
@@ -991,13 +1125,29 @@ class GmshReader {
     return out;
   }
 
+  /// The mesh facet index of each facet (vertex triple or pair, any order) of `facets`.
+  static std::vector<Index> facet_indices(const Mesh<D>& mesh, const std::vector<typename Mesh<D>::Facet>& facets) {
+    std::vector<std::vector<Index>> by_node(std::size_t(mesh.n_nodes()));
+    for (Index f = 0; f < mesh.n_facets(); ++f) by_node[std::size_t(mesh.facet(f)[0])].push_back(f);
+    std::vector<Index> out(facets.size(), -1);
+    for (std::size_t i = 0; i < facets.size(); ++i) {
+      auto k = facets[i];
+      std::sort(k.begin(), k.end());
+      for (Index f : by_node[std::size_t(k[0])])
+        if (mesh.facet(f) == k) out[i] = f;
+    }
+    return out;
+  }
+
   [[noreturn]] void undefined_node(std::int64_t tag, std::size_t line) {
     cur_.fail(line, "element references node tag " + std::to_string(tag) + ", which $Nodes does not define");
   }
 
   GmshCursor cur_;
   bool v41_ = false;
-  bool have_entities_ = false, have_nodes_ = false, have_elements_ = false;
+  bool have_entities_ = false, have_partitions_ = false, have_nodes_ = false, have_elements_ = false;
+  int n_partitions_ = 0;
+  std::set<int> ghosts_;  // ghost entities (of dimension D) of a partitioned file
   std::size_t elements_line_ = 0;
   std::map<int, std::string> names_;
   std::array<std::unordered_map<int, Entity>, 4> entities_;
@@ -1011,9 +1161,12 @@ class GmshReader {
   std::vector<std::int64_t> cell_nodes_;
   std::vector<int> cell_phys_;
   std::vector<std::size_t> cell_line_;
+  std::vector<int> cell_part_;  // partitioned files: each cell's partition
   std::vector<std::int64_t> facet_nodes_;
   std::vector<int> facet_phys_;
   std::vector<std::size_t> facet_line_;
+  // (element, tag) for an element's physical tags beyond its first
+  std::vector<std::pair<std::size_t, int>> cell_extra_, facet_extra_;
 };
 
 }  // namespace detail

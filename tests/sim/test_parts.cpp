@@ -9,12 +9,14 @@
 #include <filesystem>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "alefsi/fem/dofmap.hpp"
 #include "alefsi/mesh/io/gmsh.hpp"
 #include "alefsi/mesh/generate/mesher2d.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
 #include "alefsi/physics/stokes.hpp"
+#include "alefsi/scenes/oscillating_cylinder.hpp"
 #include "alefsi/sim/body_system.hpp"
 #include "alefsi/sim/contact2d.hpp"
 #include "alefsi/sim/flow_state.hpp"
@@ -392,4 +394,38 @@ TEST_CASE("checkpoint mesh: boundary and interior facet tags round-trip", "[sim]
     REQUIRE(m.facet_tag(f) == g.mesh.facet_tag(f));
   }
   CHECK(m.tagged_interior_facets() == g.mesh.tagged_interior_facets());
+}
+
+TEST_CASE("oscillating cylinder: Morison's coefficients of a force that follows Morison's equation", "[sim][scenes][quick]") {
+  // F = -1/2 D C_D u|u| - (pi D^2 / 4) C_I du/dt (rho = 1) sampled over three periods, fitted
+  // over the middle one: the projections recover C_D and C_I up to the trapezoidal rule's error
+  scenes::OscillatingCylinder s;
+  s.diameter = 0.5, s.max_speed = 2, s.kc = 4;
+  const Real cd = 2.09, ci = 1.45;
+  std::vector<Real> t, F;
+  const int n = 400;
+  for (int k = 0; k <= 3 * n; ++k) {
+    const Real tk = k * s.period() / n, u = s.velocity(tk), a = s.acceleration(tk);
+    t.push_back(tk);
+    F.push_back(-0.5 * s.diameter * cd * u * std::abs(u) - std::numbers::pi * s.diameter * s.diameter / 4 * ci * a);
+  }
+  CHECK(s.amplitude() == Approx(s.kc * s.diameter / (2 * std::numbers::pi)));
+  CHECK(s.position(0.3) == Approx(-s.amplitude() * std::sin(s.omega() * 0.3)));
+  const auto m = s.morison(t, F, s.period());
+  CHECK(m.drag == Approx(cd).epsilon(1e-4));
+  CHECK(m.inertia == Approx(ci).epsilon(1e-4));
+  // a window starting between samples
+  const auto m2 = s.morison(t, F, 1.3 * s.period());
+  CHECK(m2.drag == Approx(cd).epsilon(1e-4));
+  CHECK(m2.inertia == Approx(ci).epsilon(1e-4));
+  // a pure drag force has no inertia part, and the reverse
+  std::vector<Real> drag_only(F.size()), inertia_only(F.size());
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    const Real u = s.velocity(t[k]);
+    drag_only[k] = -0.5 * s.diameter * cd * u * std::abs(u);
+    inertia_only[k] = F[k] - drag_only[k];
+  }
+  CHECK(std::abs(s.morison(t, drag_only, s.period()).inertia) < 1e-4);
+  CHECK(std::abs(s.morison(t, inertia_only, s.period()).drag) < 1e-4);
+  CHECK_THROWS_AS(s.morison(t, F, 2.5 * s.period()), InvalidArgument);  // the window leaves the samples
 }

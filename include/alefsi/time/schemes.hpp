@@ -29,6 +29,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <type_traits>
 
 #include "alefsi/core/error.hpp"
@@ -177,7 +178,8 @@ inline bool scheme_name_matches(std::string_view display, std::string_view key) 
 template <class List = PaperSchemes, class F>
 decltype(auto) dispatch_scheme(std::string_view name, F&& f, std::string_view parameter = "scheme") {
   return [&]<TimeScheme... S>(SchemeList<S...>) -> decltype(auto) {
-    using R = decltype(f.template operator()<MR_AB>());
+    // the result type from the list's first scheme: probing another would instantiate f for it
+    using R = decltype(f.template operator()<std::tuple_element_t<0, std::tuple<S...>>>());
     if constexpr (std::is_void_v<R>) {
       const bool found = ((detail::scheme_name_matches(S::name, name) ? (f.template operator()<S>(), true) : false) || ...);
       if (!found) throw InvalidArgument(std::string(parameter), "unknown scheme '" + std::string(name) + "'; one of " + scheme_names<List>());

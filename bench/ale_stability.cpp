@@ -401,23 +401,6 @@ Result bisect(const Mesh<2>& mesh, Real mu, const Settings& s) {
   return r;
 }
 
-// The numbers of a comma-separated list option (`option` names it in the error).
-std::vector<Real> numbers(const std::vector<std::string>& items, const std::string& option) {
-  std::vector<Real> out;
-  for (const auto& item : items) {
-    std::size_t used = 0;
-    Real v = 0;
-    try {
-      v = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    ALEFSI_CHECK_ARG(used == item.size() && std::isfinite(v), option, "expects numbers, got '", item, "'");
-    out.push_back(v);
-  }
-  return out;
-}
-
 // "a" or "b": true for b; anything else throws naming the option.
 bool choice(const std::string& value, const char* option, const char* a, const char* b) {
   ALEFSI_CHECK_ARG(value == a || value == b, option, "must be ", a, " or ", b, ", got '", value, "'");
@@ -428,13 +411,13 @@ bool choice(const std::string& value, const char* option, const char* a, const c
 
 int main(int argc, char** argv) try {
   Settings s;
-  std::vector<std::string> schemes{"MR_AB", "BDF2_BDF2E", "BDF2_AB", "BDF3_BDF3E", "BSS"}, mu_list{"1", "0.01"},
-      probe_list;
+  std::vector<std::string> schemes{"MR_AB", "BDF2_BDF2E", "BDF2_AB", "BDF3_BDF3E", "BSS"};
+  std::vector<Real> mus{1, 0.01};
   std::string csv, inner = "fixed", pair = "gls", solver = "sparselu", lin = "newton", motion = "shear";
   Options opt("ale_stability", "Largest stable time step of each ALE scheme on the annulus, by bisection (see the file comment).");
   opt.add("schemes", schemes, "schemes, comma-separated (" + scheme_names() + ")")
       .add("h", s.h, "mesh size")
-      .add("mu", mu_list, "viscosities, comma-separated (a table row each)")
+      .add("mu", mus, "viscosities, comma-separated (a table row each)")
       .add("T", s.T, "run to max(T, min-steps dt) (< 0: 2, or 1 with --inner free)")
       .add("min-steps", s.min_steps, "at least this many steps (< 0: 200, or 5 with --inner free)")
       .add("startup-steps", s.startup_steps, "the energy test starts after this many steps")
@@ -452,7 +435,7 @@ int main(int argc, char** argv) try {
       .add("solver", solver, "sparselu or umfpack (a build with SuiteSparse)")
       .add("remesh", s.remesh_quality, "--inner free: remesh below this cell quality (0: off)")
       .flag("remesh-size", s.remesh_size, "with --remesh: target size h (its size band triggers too)")
-      .add("probes", probe_list, "run these dt (comma-separated) instead of the bisection")
+      .add("probes", s.probe_dts, "run these dt (comma-separated) instead of the bisection")
       .add("trace", s.trace_dt, "one verbose run at this dt per scheme and mu (0: off)")
       .add("trace-every", s.trace_every, "with --trace: print every N-th step (0: the first 12, then ~40 lines)")
       .add("csv", csv, "CSV file of the bisection's results");
@@ -468,8 +451,6 @@ int main(int argc, char** argv) try {
   // the free body's runs are short: the mesh shears as it turns (file comment)
   if (s.T < 0) s.T = s.free_body ? 1 : 2;
   if (s.min_steps < 0) s.min_steps = s.free_body ? 5 : 200;
-  const std::vector<Real> mus = numbers(mu_list, "--mu");
-  s.probe_dts = numbers(probe_list, "--probes");
   for (const auto& key : schemes) dispatch_scheme(key, []<class S>() {}, "--schemes");  // every name known
   ALEFSI_CHECK_ARG(s.remesh_quality == 0 || (s.free_body && s.remesh_quality > 0 && s.remesh_quality < 1), "--remesh",
                    "needs --inner free and 0 < Q < 1, got ", s.remesh_quality);

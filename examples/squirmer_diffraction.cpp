@@ -81,38 +81,21 @@ Real run_scene(const Setup& s, bool passive, Real kappa, const std::filesystem::
   return (x3 - x1) / 2;
 }
 
-// The numbers of a comma-separated list option (`option` names it in the error).
-std::vector<Real> numbers(const std::vector<std::string>& items, const std::string& option) {
-  std::vector<Real> out;
-  for (const auto& item : items) {
-    std::size_t used = 0;
-    Real v = 0;
-    try {
-      v = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    ALEFSI_CHECK_ARG(used == item.size() && std::isfinite(v), option, "expects numbers, got '", item, "'");
-    out.push_back(v);
-  }
-  return out;
-}
 }  // namespace
 
 int main(int argc, char** argv) try {
   Setup s{0.025, 0, 0.02, 0.4};
   Real t_hat = 48;
-  std::vector<std::string> kappa_list = {"0", "0.5", "1", "1.3", "2", "3"};
+  std::vector<Real> kappas = {0, 0.5, 1, 1.3, 2, 3};
   std::filesystem::path out = "output/squirmer_diffraction";
   Options opt("squirmer_diffraction", "A 2D squirmer passing a free passive disk (paper 6.4, Figures 8-10).");
-  opt.add("kappa", kappa_list, "initial offsets kappa = e / R of the squirmer's path, comma-separated")
+  opt.add("kappa", kappas, "initial offsets kappa = e / R of the squirmer's path, comma-separated")
       .add("t-hat", t_hat, "run length per kappa in units of R / v* (t = t-hat R / v*)")
       .add("dt", s.dt, "time step (s)")
       .add("h-body", s.h_body, "mesh size at the disks (cm)")
       .add("h-far", s.h_far, "mesh size far from the disks (cm)")
       .add("output", out, "folder for alone/ and kappa_<k>/ (bodies.csv)");
   if (!opt.parse(argc, argv, std::cout)) return 0;
-  const std::vector<Real> kappas = numbers(kappa_list, "--kappa");
   opt.print(std::cout);
   const Real v_star = run_scene(s, false, 0, out / "alone");
   std::cout << "unperturbed squirmer speed v* = " << std::setprecision(4) << v_star

@@ -8,9 +8,11 @@
 #include <cmath>
 #include <filesystem>
 #include <numbers>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "alefsi/app/options.hpp"
 #include "alefsi/fem/dofmap.hpp"
 #include "alefsi/mesh/io/gmsh.hpp"
 #include "alefsi/mesh/generate/mesher2d.hpp"
@@ -428,4 +430,49 @@ TEST_CASE("oscillating cylinder: Morison's coefficients of a force that follows 
   CHECK(std::abs(s.morison(t, drag_only, s.period()).inertia) < 1e-4);
   CHECK(std::abs(s.morison(t, inertia_only, s.period()).drag) < 1e-4);
   CHECK_THROWS_AS(s.morison(t, F, 2.5 * s.period()), InvalidArgument);  // the window leaves the samples
+}
+
+TEST_CASE("options: numbers, lists, flags and positionals; a bad value names its option", "[sim][app][quick]") {
+  std::string mode;
+  Real dt = 1e-3;
+  int n = 3;
+  bool newton = false;
+  std::vector<Real> mus{1, 0.01};
+  std::vector<std::string> names{"a"};
+  auto make = [&] {
+    Options o("prog", "test");
+    o.positional("mode", mode, "the mode").add("dt", dt, "step").add("n", n, "count").add("mu", mus, "viscosities");
+    o.add("names", names, "names").flag("newton", newton, "Newton");
+    return o;
+  };
+  auto parse = [&](std::vector<const char*> args) {
+    args.insert(args.begin(), "prog");
+    std::ostringstream out;
+    return make().parse(int(args.size()), args.data(), &out);
+  };
+  REQUIRE(parse({"fig7", "--dt", "0.5", "--n=7", "--mu", "2,0.25,1e-3", "--names", "x,y", "--newton"}));
+  CHECK(mode == "fig7");
+  CHECK(dt == 0.5);
+  CHECK(n == 7);
+  CHECK(mus == std::vector<Real>{2, 0.25, 1e-3});
+  CHECK(names == std::vector<std::string>{"x", "y"});
+  CHECK(newton);
+  auto param_of = [&](std::vector<const char*> args) {
+    try {
+      parse(args);
+    } catch (const InvalidArgument& e) {
+      return e.parameter();
+    }
+    return std::string("<no throw>");
+  };
+  CHECK(param_of({"--mu", "1,x"}) == "--mu");    // an item that is not a number
+  CHECK(param_of({"--mu", "1,inf"}) == "--mu");  // nor a finite one
+  CHECK(param_of({"--n", "2.5"}) == "--n");
+  CHECK(param_of({"--dt", ""}) == "--dt");
+  // --help lists every option with its default, and parse returns false
+  std::ostringstream help;
+  const char* h[] = {"prog", "--help"};
+  mus = {1, 0.01};
+  CHECK_FALSE(make().parse(2, h, &help));
+  CHECK_THAT(help.str(), Catch::Contains("--mu") && Catch::Contains("(default 1,0.01)") && Catch::Contains("--newton"));
 }

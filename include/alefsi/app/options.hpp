@@ -6,7 +6,7 @@
 /// says how it was made). As MFEM's OptionsParser, in C++20.
 ///
 ///   - `--name value` (or `--name=value`) for numbers, strings, paths and lists
-///     (`std::vector<std::string>`, comma-separated);
+///     (`std::vector<std::string>`, `std::vector<double>`, ...: comma-separated);
 ///   - `--name` alone for a flag (bool set to true); `--no-name` sets it to false;
 ///   - positional arguments (e.g. a mode) are declared with `positional`.
 /// A bad value or an unknown option throws InvalidArgument naming the option; `parse` returns
@@ -32,12 +32,19 @@
 
 namespace alefsi {
 
+namespace detail {
+template <class T>
+inline constexpr bool is_option_list = false;
+template <class T>
+inline constexpr bool is_option_list<std::vector<T>> = true;
+}  // namespace detail
+
 class Options {
  public:
   Options(std::string program, std::string summary) : program_(std::move(program)), summary_(std::move(summary)) {}
 
   /// `--name value`: `value` holds the default and receives the parsed value. T: int, long,
-  /// double, std::string, std::filesystem::path or std::vector<std::string> (comma-separated).
+  /// double, std::string, std::filesystem::path or a std::vector of these (comma-separated).
   template <class T>
   Options& add(const std::string& name, T& value, const std::string& help) {
     Entry e{name, help, false, [&value] { return show(value); }, {}};
@@ -139,11 +146,11 @@ class Options {
       return text;
     } else if constexpr (std::is_same_v<T, std::filesystem::path>) {
       return std::filesystem::path(text);
-    } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
-      std::vector<std::string> out;
+    } else if constexpr (detail::is_option_list<T>) {  // comma-separated; each item converted as one value
+      T out;
       std::stringstream ss(text);
       for (std::string item; std::getline(ss, item, ',');)
-        if (!item.empty()) out.push_back(item);
+        if (!item.empty()) out.push_back(convert<typename T::value_type>(name, item));
       return out;
     } else if constexpr (std::is_floating_point_v<T>) {
       std::size_t used = 0;
@@ -171,9 +178,9 @@ class Options {
       return v.empty() ? std::string("''") : v;
     } else if constexpr (std::is_same_v<T, std::filesystem::path>) {
       return v.empty() ? std::string("''") : v.string();
-    } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+    } else if constexpr (detail::is_option_list<T>) {
       std::string s;
-      for (const auto& x : v) s += (s.empty() ? "" : ",") + x;
+      for (const auto& x : v) s += (s.empty() ? "" : ",") + show(x);
       return s.empty() ? std::string("''") : s;
     } else {
       std::ostringstream o;

@@ -383,6 +383,64 @@ TEST_CASE("Navier-Stokes kernel (reference integrals, exact-degree rule) equals 
   compare_ns_kernels<3, TaylorHood, false>(Linearisation::newton);
 }
 
+namespace {
+// The element matrix of the Navier-Stokes kernel is the exact derivative of its element residual:
+// central differences of r, exact for a residual quadratic in u (Newton: u_th . grad u_th, the
+// SUPG test function (a . grad) w with a = u_th - v) and linear (semi-implicit), up to round-off.
+// Independent of the quadrature oracle, which shares the kernels' formulas.
+template <int D, class Pair>
+void check_ns_jacobian_by_differences(Linearisation lin) {
+  const auto mesh = distorted_mesh<D>(D == 2 ? 3 : 1);
+  using Space = MixedSpace<D, Pair>;
+  Space space(mesh);
+  const Index nf = space.n_field();
+  VecX prev(nf), hist(nf), ustar(nf);
+  for (Index f = 0; f < nf; ++f) {
+    prev[f] = std::sin(0.7 * f + 0.2);
+    hist[f] = std::cos(0.3 * f);
+    ustar[f] = std::sin(1.9 * f) + 0.3;
+  }
+  std::vector<Vec<D>> vmesh(mesh.n_nodes());
+  for (Index v = 0; v < mesh.n_nodes(); ++v)
+    for (int k = 0; k < D; ++k) vmesh[v][k] = 0.2 * std::sin(2.0 * mesh.node(v)[(k + 1) % D] + k);
+  StepInputs<D> in;
+  in.dt = 0.05, in.theta = 0.5, in.a0 = 1.5;
+  in.previous = &prev, in.history = &hist, in.extrapolated = &ustar, in.mesh_velocity = &vmesh;
+  in.force = [](const Vec<D>& x) { return Vec<D>(Vec<D>::Constant(std::cos(x[0]))); };
+  AleNavierStokesKernel<D, Pair, true> k(space, 1.3, 0.05, lin);
+  k.set_step(in);
+  using LV = Eigen::Matrix<Real, Space::n_local, 1>;
+  using LM = Eigen::Matrix<Real, Space::n_local, Space::n_local>;
+  Real worst = 0;
+  const Real eps = 1e-4;
+  for (Index c = 0; c < mesh.n_cells(); ++c) {
+    LV u, r, rp, rm;
+    LM A, dummy;
+    for (int i = 0; i < Space::n_local; ++i) u[i] = std::sin(0.9 * c + 1.1 * i);
+    k.cell(c, u, A, r);
+    for (int j = 0; j < Space::n_local; ++j) {
+      LV up = u, um = u;
+      up[j] += eps, um[j] -= eps;
+      k.cell(c, up, dummy, rp);
+      k.cell(c, um, dummy, rm);
+      worst = std::max(worst, ((rp - rm) / (2 * eps) - A.col(j)).norm() / A.norm());
+    }
+  }
+  INFO(D << "D " << Pair::name << (lin == Linearisation::newton ? " Newton" : " semi-implicit")
+         << ": worst relative difference of a column " << worst);
+  CHECK(worst <= 1e-9);
+}
+}  // namespace
+
+TEST_CASE("Navier-Stokes kernel: the element matrix is the derivative of the element residual (GLS included)",
+          "[la][assembly][navier_stokes][quick]") {
+  for (auto lin : {Linearisation::newton, Linearisation::semi_implicit}) {
+    check_ns_jacobian_by_differences<2, P1P1Gls>(lin);
+    check_ns_jacobian_by_differences<2, TaylorHood>(lin);
+    check_ns_jacobian_by_differences<3, P1P1Gls>(lin);
+  }
+}
+
 TEST_CASE("assembly with partly fixed nodes and a 6-unknown link equals the dense T^T A T", "[la][assembly][quick]") {
   // component 0 fixed on the outer circle (component 1 free: blocks of one), the inner circle
   // linked to 6 extra unknowns (a block of 6: the generic scatter path), pressure free

@@ -3,7 +3,10 @@
 // scheme-name dispatch.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <complex>
 #include <string>
 
 #include "alefsi/time.hpp"
@@ -110,8 +113,18 @@ TEST_CASE("Stepper: start-up while the history is short, a damped start when ask
   CHECK(!p.coefficients.backfill);
   h.advance(0.01);
   CHECK(bdf3.plan(h, 0.01).kind == StepKind::regular);
-  CHECK(Stepper<BDF3_BDF3E>::restarts(h, 0.005));
-  CHECK(!Stepper<BDF3_BDF3E>::restarts(h, 0.01));
+  CHECK(bdf3.restarts(h, 0.005));
+  CHECK(!bdf3.restarts(h, 0.01));
+  // variable steps: any shrinking, and growth up to the scheme's ratio bound, keep the history
+  const Stepper<BDF3_BDF3E> var3(0, true);
+  CHECK(!var3.restarts(h, 0.001));
+  CHECK(!var3.restarts(h, 0.015));
+  CHECK(var3.restarts(h, 0.0151));
+  CHECK(var3.plan(h, 0.013).kind == StepKind::regular);
+  const Stepper<BDF2_BDF2E> var2(0, true);
+  CHECK(!var2.restarts(h, 0.02));
+  CHECK(var2.restarts(h, 0.0201));
+  CHECK(!Stepper<MR_AB>(0, true).restarts(h, 1.0));  // one-step flow and positions: no bound
   CHECK(Stepper<BSS>().plan(TimeHistory{}, 0.1).kind == StepKind::regular);  // BSS reads no past level
 
   const Stepper<BDF3_BDF3E> damped3(4);
@@ -122,6 +135,38 @@ TEST_CASE("Stepper: start-up while the history is short, a damped start when ask
   CHECK(p.coefficients.dt == 0.005);
   CHECK(!Stepper<BDF2_BDF2E>(2).plan(TimeHistory{}, 0.02).richardson);
   CHECK_THROWS_WITH(Stepper<MR_AB>(3), Catch::Contains("damped_start"));
+}
+
+namespace {
+/// The largest modulus of the roots of sum_k a_k z^{l-k} other than z = 1 (which every
+/// consistent BDF has), for the BDF-l weights a_k with a constant step ratio w.
+Real spurious_root(int l, Real w) {
+  const Real dt = 1;
+  const auto a = variable_bdf_coefficients(l, dt, {dt / w, dt / (w * w), 0});
+  // deflate (z - 1): q has degree l - 1
+  std::array<Real, 3> q{a[0], 0, 0};
+  for (int k = 1; k < l; ++k) q[std::size_t(k)] = a[std::size_t(k)] + q[std::size_t(k - 1)];
+  if (l == 2) return std::abs(q[1] / q[0]);
+  const std::complex<Real> d = std::sqrt(std::complex<Real>(q[1] * q[1] - 4 * q[0] * q[2]));
+  return std::max(std::abs((-q[1] + d) / (2 * q[0])), std::abs((-q[1] - d) / (2 * q[0])));
+}
+}  // namespace
+
+TEST_CASE("variable-step BDF: zero-stable for constant ratios below 1 + sqrt(2) (BDF2), (1 + sqrt(5))/2 (BDF3)",
+          "[time][stepper][quick]") {
+  const Real r2 = 1 + std::sqrt(2.0), r3 = (1 + std::sqrt(5.0)) / 2;
+  CHECK(spurious_root(2, 1.0) == Approx(1.0 / 3));  // the constant-step BDF2 root
+  for (Real w : {0.01, 0.1, 0.5, 1.0, 1.5, 2.0, 0.999 * r2}) CHECK(spurious_root(2, w) < 1);
+  CHECK(spurious_root(2, 1.001 * r2) > 1);
+  for (Real w : {0.01, 0.1, 0.5, 1.0, 1.3, 1.5, 0.999 * r3}) CHECK(spurious_root(3, w) < 1);
+  CHECK(spurious_root(3, 1.001 * r3) > 1);
+  // the enforced bounds lie inside, with a margin
+  CHECK(max_step_ratio<BDF2_BDF2E>() == 2.0);
+  CHECK(max_step_ratio<BDF2_AB>() == 2.0);
+  CHECK(max_step_ratio<BDF3_BDF3E>() == 1.5);
+  CHECK(std::isinf(max_step_ratio<MR_AB>()));
+  CHECK(spurious_root(2, max_step_ratio<BDF2_BDF2E>()) <= 0.8 + 1e-12);
+  CHECK(spurious_root(3, max_step_ratio<BDF3_BDF3E>()) < 0.9);
 }
 
 TEST_CASE("dispatch_scheme: display or type name to the scheme type, unknown names listed", "[time][quick]") {

@@ -98,6 +98,11 @@ struct FlowOptions {
   /// t^n + dt (equal spacing dt); a scheme that needs more levels continues with its MR/AB
   /// start-up steps.
   int damped_start = 0;
+  /// Variable steps: a step of another dt than the last keeps the history and uses the
+  /// variable-step formulas (time/stepper.hpp), unless it grows by more than the scheme's
+  /// step-ratio bound (2 for BDF2, 1.5 for BDF3: max_step_ratio), which restarts it. false
+  /// (default): every change of dt restarts the history (start-up formulas).
+  bool variable_steps = false;
   /// Threads of the flow system's assembly (Assembler::set_threads; default 1). Results are
   /// bit-identical for every count. With more than one, the user's force callback
   /// (set_force) is called concurrently and must be safe to call so (a pure function is).

@@ -26,6 +26,7 @@
 ///     static_assert(alefsi::TimeScheme<S> && S::order == 3);
 #include <array>
 #include <concepts>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -140,6 +141,21 @@ constexpr int history_levels() {
 static_assert(TimeScheme<MR_AB> && TimeScheme<BDF2_BDF2E> && TimeScheme<BDF2_AB> && TimeScheme<BDF3_BDF3E> &&
                   TimeScheme<BSS>,
               "the five schemes of the paper must model TimeScheme");
+
+/// The largest step ratio dt_n / dt_{n-1} under which the variable-step BDF formula of order l
+/// is used (larger: the history restarts). Zero-stability with a constant ratio w (the root
+/// condition of sum_k a_k(w) z^{l-k} = 0, checked in tests/sim/test_time.cpp) holds for
+/// w < 1 + sqrt(2) = 2.414 (l = 2; Grigorieff 1983) and w < (1 + sqrt(5)) / 2 = 1.618 (l = 3);
+/// varying ratios are stricter than constant ones, so the bounds keep a margin: 2 and 1.5.
+/// Shrinking steps (w < 1) need no bound. l = 1 (and the midpoint rule) is one-step: none.
+constexpr Real max_step_ratio(int l) { return l <= 1 ? std::numeric_limits<Real>::infinity() : l == 2 ? 2.0 : 1.5; }
+/// The scheme's bound: the smaller of its flow's and its positions' (the extrapolations are
+/// explicit and need none).
+template <TimeScheme S>
+constexpr Real max_step_ratio() {
+  const Real a = max_step_ratio(S::flow_bdf), b = max_step_ratio(S::position_bdf);
+  return a < b ? a : b;
+}
 
 /// A compile-time list of schemes.
 template <TimeScheme... S>

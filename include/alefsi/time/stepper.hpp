@@ -23,8 +23,9 @@
 /// the history holds fewer levels than the scheme reads, with MR/AB start-up coefficients
 /// (self-starting; the very first one back-fills level n-1, `StepCoefficients::backfill`), or
 /// as a damped start (m backward-Euler substeps, Richardson-extrapolated for design order >= 3;
-/// sim/ale_flow.hpp carries it out). The constant-step formulas restart the history when dt
-/// changes (`restarts`).
+/// sim/ale_flow.hpp carries it out). With constant steps (the default) a change of dt restarts
+/// the history; with variable steps (`Stepper(m, true)`) the variable-step formulas take it,
+/// unless the step grows by more than the scheme's `max_step_ratio` (`restarts`).
 ///
 ///     Stepper<BDF3_BDF3E> stepper;
 ///     StepPlan plan = stepper.plan(history, 0.01);   // plan.kind, plan.coefficients
@@ -169,16 +170,24 @@ template <TimeScheme S>
 class Stepper {
  public:
   using Scheme = S;
-  /// `damped_start` = m (even, 2..64), or 0 for the multistep start-up.
-  explicit Stepper(int damped_start = 0) : damped_start_(damped_start) {
+  /// `damped_start` = m (even, 2..64), or 0 for the multistep start-up; `variable_steps`: a
+  /// change of dt keeps the history (within the scheme's step-ratio bound).
+  explicit Stepper(int damped_start = 0, bool variable_steps = false)
+      : damped_start_(damped_start), variable_(variable_steps) {
     ALEFSI_CHECK_ARG(damped_start == 0 || (damped_start >= 2 && damped_start <= 64 && damped_start % 2 == 0),
                      "damped_start", "must be 0 (off) or an even number of substeps in 2..64, got ", damped_start);
   }
   int damped_start() const { return damped_start_; }
 
-  /// Whether a step of dt after history h restarts it: the constant-step formulas restart
-  /// from the current state when dt differs from the last step.
-  static bool restarts(const TimeHistory& h, Real dt) { return h.levels() > 0 && dt != h.last_step(); }
+  bool variable_steps() const { return variable_; }
+
+  /// Whether a step of dt after history h restarts it: with constant steps when dt differs from
+  /// the last step; with variable steps when it exceeds the last one by more than the scheme's
+  /// step-ratio bound (max_step_ratio<S>).
+  bool restarts(const TimeHistory& h, Real dt) const {
+    if (h.levels() == 0 || dt == h.last_step()) return false;
+    return !variable_ || dt > max_step_ratio<S>() * h.last_step();
+  }
 
   /// The plan of a step of dt after history h (already restarted if `restarts` said so).
   StepPlan plan(const TimeHistory& h, Real dt) const {
@@ -202,6 +211,7 @@ class Stepper {
 
  private:
   int damped_start_ = 0;
+  bool variable_ = false;
 };
 
 }  // namespace alefsi

@@ -8,14 +8,19 @@
 //                     omega = 1 from t = 0+), h 0.05, P1/P1-GLS, MR/AB, dt 2e-3: 10^4 steps, t = 20; the free
 //                     inner cylinder spins up and its rotation tangles the mesh, which is adapted
 //                     whenever its quality drops below 0.35. Bound: the energy of rigid rotation at
-//                     omega = 1 (the state the spin-up tends to).
+//                     omega = 1 (the state the spin-up tends to). `--spin 20 --rho-s 1000`: the
+//                     cylinder starts at 20 rad/s and, heavy, keeps turning: a remesh every few steps.
 // From step 100 on (before it nearly nothing is dissipated, so E is close to its bound and the
 // lumped energy's quadrature error decides), a step whose energy exceeds its bound is counted.
-// Every `--report` steps: time, remeshes, resident memory (VmRSS) and its peak (VmHWM) from
-// /proc/self/status, the kinetic energy (fluid, by the vertex-lumped mass of the velocity at the
-// vertices) and its bound. Exit status 1 on a NaN, an energy above its bound, or a run failure.
+// Every `--report` steps: time, remeshes, the mesh's cells, resident memory (VmRSS) and its
+// peak (VmHWM) from /proc/self/status, the kinetic energy (fluid, by the vertex-lumped mass of
+// the velocity at the vertices) and its bound. Exit status 1 on a NaN, an energy above its bound, or a run failure.
 // Command and measured numbers: docs/performance.md ("Long runs").
 #include <alefsi/alefsi.hpp>
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include <chrono>
 #include <cmath>
@@ -31,6 +36,19 @@
 using namespace alefsi;
 
 namespace {
+
+/// The bytes the allocator has handed out and not got back (MB): glibc's mallinfo2, heap and
+/// mmapped blocks; -1 without glibc. Unlike the RSS it does not depend on where the allocator
+/// put the blocks (glibc raises its mmap threshold as large blocks are freed, so the solver's
+/// large blocks move from mmap to the heap, whose pages stay resident).
+double allocated_mb() {
+#if defined(__GLIBC__)
+  const auto m = mallinfo2();
+  return double(m.uordblks + m.hblkhd) / 1048576.0;
+#else
+  return -1;
+#endif
+}
 
 /// VmRSS and VmHWM of this process (MB), from /proc/self/status (0 where it is not readable).
 std::pair<double, double> memory_mb() {
@@ -76,8 +94,8 @@ int monitor_run(Flow& flow, const std::vector<RigidBody2D>& bodies, Real rho, Re
   Real emax_ratio = 0;
   const auto wall0 = std::chrono::steady_clock::now();
   const std::clock_t cpu0 = std::clock();
-  std::printf("| %s step | t | remeshes | RSS (MB) | peak RSS (MB) | E (fluid + bodies) | bound | wall (s) | CPU (s) |\n"
-              "|---|---|---|---|---|---|---|---|---|\n", name.c_str());
+  std::printf("| %s step | t | remeshes | cells | RSS (MB) | peak RSS (MB) | allocated (MB) | E (fluid + bodies) | bound | wall (s) | CPU (s) |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|\n", name.c_str());
   RunOptions ro;
   ro.dt = dt;
   ro.t_end = flow.time() + steps * dt;
@@ -95,8 +113,8 @@ int monitor_run(Flow& flow, const std::vector<RigidBody2D>& bodies, Real rho, Re
     }
     if (step % report == 0 || step == steps) {
       const auto [rss, hwm] = memory_mb();
-      std::printf("| %d | %.3f | %ld | %.1f | %.1f | %.5g | %.5g | %.0f | %.0f |\n", step, flow.time(),
-                  long(flow.stats().remeshes), rss, hwm, e, b,
+      std::printf("| %d | %.3f | %ld | %ld | %.1f | %.1f | %.1f | %.5g | %.5g | %.0f | %.0f |\n", step, flow.time(),
+                  long(flow.stats().remeshes), long(flow.mesh().n_cells()), rss, hwm, allocated_mb(), e, b,
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count(),
                   double(std::clock() - cpu0) / CLOCKS_PER_SEC);
       std::fflush(stdout);
@@ -131,8 +149,9 @@ int dkt(int steps, int report) {
   return monitor_run(flow, bodies, rho, 1e-3, steps, report, "dkt", bound);
 }
 
-int annulus(int steps, int report) {
-  const scenes::Annulus scene{.rho_s = 1.25};
+int annulus(int steps, int report, Real spin, Real rho_s) {
+  scenes::Annulus scene{.rho_s = rho_s};
+  scene.initial_velocity = Vec<3>(0, 0, spin);
   const Real h = 0.05, rho = 1;
   using Flow = AleFlow<FlowConfig<2, P1P1Gls, MR_AB>>;
   Flow flow(scene.mesh(h), FlowOptions{.rho = rho, .mu = 0.01});
@@ -142,9 +161,11 @@ int annulus(int steps, int report) {
                       .size = [h](const std::vector<Circle>&) { return SizeFunction([h](const Vec<2>&) { return h; }); },
                       .adapt = {}});
   scene.start_with_moving_wall(flow);
-  // rigid rotation at omega = 1: fluid 1/2 rho int r^2 dA plus the cylinder's 1/2 I
-  const Real r1 = scene.r1, r2 = scene.r2;
-  const Real rigid = 0.25 * rho * std::numbers::pi * (std::pow(r2, 4) - std::pow(r1, 4)) + 0.5 * scene.inner_body().inertia;
+  // rigid rotation at max(omega_wall = 1, |spin|): fluid 1/2 rho int r^2 dA plus the cylinder's
+  // 1/2 I (with a spin the cylinder starts faster than the wall and is slowed down)
+  const Real r1 = scene.r1, r2 = scene.r2, w = std::max(1.0, std::abs(spin));
+  const Real rigid =
+      w * w * (0.25 * rho * std::numbers::pi * (std::pow(r2, 4) - std::pow(r1, 4)) + 0.5 * scene.inner_body().inertia);
   return monitor_run(flow, {scene.inner_body()}, rho, 2e-3, steps, report, "annulus",
                      [rigid](const Flow&) { return rigid; });
 }
@@ -154,15 +175,18 @@ int annulus(int steps, int report) {
 int main(int argc, char** argv) try {
   std::string mode;
   int steps = 10000, report = 1000;
+  Real spin = 0, rho_s = 1.25;
   Options opt("long_run", "Runs of 10^4 steps: no NaN, no memory growth, energy bounded (see the file comment).");
   opt.positional("mode", mode, "dkt | annulus")
       .add("steps", steps, "number of steps")
-      .add("report", report, "a table row every N steps");
+      .add("report", report, "a table row every N steps")
+      .add("spin", spin, "annulus: the inner cylinder's initial angular velocity (a stress test of remeshing)")
+      .add("rho-s", rho_s, "annulus: the inner cylinder's density");
   if (!opt.parse(argc, argv, std::cout)) return 0;
   opt.print(std::cout);
   ALEFSI_CHECK_ARG(steps >= 1 && report >= 1, "--steps, --report", "must be >= 1");
   if (mode == "dkt") return dkt(steps, report);
-  if (mode == "annulus") return annulus(steps, report);
+  if (mode == "annulus") return annulus(steps, report, spin, rho_s);
   throw InvalidArgument("mode", "dkt or annulus, got '" + mode + "'");
 } catch (const std::exception& e) {
   std::fprintf(stderr, "long_run: %s\n", e.what());

@@ -318,40 +318,46 @@ TEST_CASE("threaded assembly is bit-identical to one thread; a throwing kernel i
 }
 
 namespace {
+// Step inputs with every member set (theta < 1, history, u*, mesh velocity, force), smooth
+// fields on a mesh with nf field unknowns. `in` points into the members: not copyable.
+template <int D>
+struct FullStepInputs {
+  VecX prev, hist, ustar;
+  std::vector<Vec<D>> vmesh;
+  StepInputs<D> in;
+
+  FullStepInputs(const Mesh<D>& mesh, Index nf) : prev(nf), hist(nf), ustar(nf), vmesh(mesh.n_nodes()) {
+    for (Index f = 0; f < nf; ++f) {
+      prev[f] = std::sin(0.7 * f + 0.2);
+      hist[f] = std::cos(0.3 * f);
+      ustar[f] = std::sin(1.9 * f) + 0.3;
+    }
+    for (Index v = 0; v < mesh.n_nodes(); ++v)
+      for (int k = 0; k < D; ++k) vmesh[v][k] = 0.2 * std::sin(2.0 * mesh.node(v)[(k + 1) % D] + k);
+    in.dt = 0.05, in.theta = 0.5, in.a0 = 1.5;
+    in.previous = &prev, in.history = &hist, in.extrapolated = &ustar, in.mesh_velocity = &vmesh;
+    in.force = [](const Vec<D>& x) {
+      Vec<D> f;
+      for (int i = 0; i < D; ++i) f[i] = std::cos(1.3 * x[i] + i) * std::exp(0.4 * x[(i + 1) % D]);
+      return f;
+    };
+  }
+  FullStepInputs(const FullStepInputs&) = delete;
+  FullStepInputs& operator=(const FullStepInputs&) = delete;
+};
+
 // Compares AleNavierStokesKernel with its oracle AleNavierStokesQuadratureKernel cell by cell on a
-// distorted mesh, with every step input set (theta < 1, history, u*, mesh velocity, force).
+// distorted mesh, with every step input set.
 template <int D, class Pair, bool Convection>
 void compare_ns_kernels(Linearisation lin) {
   const auto mesh = distorted_mesh<D>(D == 2 ? 4 : 2);
   using Space = MixedSpace<D, Pair>;
   Space space(mesh);
-  const Index nf = space.n_field();
-  VecX prev(nf), hist(nf), ustar(nf);
-  for (Index f = 0; f < nf; ++f) {
-    prev[f] = std::sin(0.7 * f + 0.2);
-    hist[f] = std::cos(0.3 * f);
-    ustar[f] = std::sin(1.9 * f) + 0.3;
-  }
-  std::vector<Vec<D>> vmesh(mesh.n_nodes());
-  for (Index v = 0; v < mesh.n_nodes(); ++v)
-    for (int k = 0; k < D; ++k) vmesh[v][k] = 0.2 * std::sin(2.0 * mesh.node(v)[(k + 1) % D] + k);
-  StepInputs<D> in;
-  in.dt = 0.05;
-  in.theta = 0.5;
-  in.a0 = 1.5;
-  in.previous = &prev;
-  in.history = &hist;
-  in.extrapolated = &ustar;
-  in.mesh_velocity = &vmesh;
-  in.force = [](const Vec<D>& x) {
-    Vec<D> f;
-    for (int i = 0; i < D; ++i) f[i] = std::cos(1.3 * x[i] + i) * std::exp(0.4 * x[(i + 1) % D]);
-    return f;
-  };
+  const FullStepInputs<D> step(mesh, space.n_field());
   AleNavierStokesKernel<D, Pair, Convection> fast(space, 1.3, 0.05, lin);
   testing::AleNavierStokesQuadratureKernel<D, Pair, Convection> ref(space, 1.3, 0.05, lin);
-  fast.set_step(in);
-  ref.set_step(in);
+  fast.set_step(step.in);
+  ref.set_step(step.in);
   Real worst_A = 0, worst_r = 0;
   for (Index c = 0; c < mesh.n_cells(); ++c) {
     Eigen::Matrix<Real, Space::n_local, 1> u, r1, r2;
@@ -393,22 +399,9 @@ void check_ns_jacobian_by_differences(Linearisation lin) {
   const auto mesh = distorted_mesh<D>(D == 2 ? 3 : 1);
   using Space = MixedSpace<D, Pair>;
   Space space(mesh);
-  const Index nf = space.n_field();
-  VecX prev(nf), hist(nf), ustar(nf);
-  for (Index f = 0; f < nf; ++f) {
-    prev[f] = std::sin(0.7 * f + 0.2);
-    hist[f] = std::cos(0.3 * f);
-    ustar[f] = std::sin(1.9 * f) + 0.3;
-  }
-  std::vector<Vec<D>> vmesh(mesh.n_nodes());
-  for (Index v = 0; v < mesh.n_nodes(); ++v)
-    for (int k = 0; k < D; ++k) vmesh[v][k] = 0.2 * std::sin(2.0 * mesh.node(v)[(k + 1) % D] + k);
-  StepInputs<D> in;
-  in.dt = 0.05, in.theta = 0.5, in.a0 = 1.5;
-  in.previous = &prev, in.history = &hist, in.extrapolated = &ustar, in.mesh_velocity = &vmesh;
-  in.force = [](const Vec<D>& x) { return Vec<D>(Vec<D>::Constant(std::cos(x[0]))); };
+  const FullStepInputs<D> step(mesh, space.n_field());
   AleNavierStokesKernel<D, Pair, true> k(space, 1.3, 0.05, lin);
-  k.set_step(in);
+  k.set_step(step.in);
   using LV = Eigen::Matrix<Real, Space::n_local, 1>;
   using LM = Eigen::Matrix<Real, Space::n_local, Space::n_local>;
   Real worst = 0;
@@ -501,27 +494,14 @@ void check_ns_threads(int n) {
     for (int k = 0; k < D; ++k) cons.fix(space.velocity_field(i, k), 0.2 * k + 0.1);
   cons.finalize();
   const Index nf = space.n_field();
-  VecX field(nf), prev(nf), hist(nf), ustar(nf);
-  for (Index f = 0; f < nf; ++f) {
-    field[f] = std::cos(0.3 * f);
-    prev[f] = std::sin(0.7 * f + 0.2);
-    hist[f] = std::cos(0.3 * f);
-    ustar[f] = std::sin(1.9 * f) + 0.3;
-  }
+  VecX field(nf);
+  for (Index f = 0; f < nf; ++f) field[f] = std::cos(0.3 * f);
   field = cons.expand(cons.restrict_free(field));
-  std::vector<Vec<D>> vmesh(mesh.n_nodes());
-  for (Index v = 0; v < mesh.n_nodes(); ++v)
-    for (int k = 0; k < D; ++k) vmesh[v][k] = 0.2 * std::sin(2.0 * mesh.node(v)[(k + 1) % D] + k);
-  StepInputs<D> in;
-  in.dt = 0.05;
-  in.theta = 1;
-  in.a0 = 1.5;
-  in.previous = &prev;
-  in.history = &hist;
-  in.extrapolated = &ustar;
-  in.mesh_velocity = &vmesh;
+  FullStepInputs<D> step(mesh, nf);
+  step.in.theta = 1;
+  step.in.force = {};
   AleNavierStokesKernel<D, Pair> k(space, 1.3, 0.05, Linearisation::newton);
-  k.set_step(in);
+  k.set_step(step.in);
   Assembler<Space::n_local> asmb(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
   REQUIRE(asmb.n_colours() >= 2);
   SparseMatrix J1, J2;

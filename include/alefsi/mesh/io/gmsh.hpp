@@ -555,21 +555,13 @@ class GmshReader {
   void parse_entities() {
     if (cur_.binary()) cur_.end_marker_line();
     cur_.begin_block();
-    std::array<std::int64_t, 4> count{};
-    for (int d = 0; d < 4; ++d) {
-      // a point needs >= 5 tokens (36 bytes in binary), a curve/surface/volume >= 9 (68 bytes)
-      count[d] = cur_.read_count(d == 0 ? "number of points" : d == 1 ? "number of curves"
-                                        : d == 2             ? "number of surfaces"
-                                                             : "number of volumes",
-                                 d == 0 ? 10 : 18, d == 0 ? 36 : 68);
-    }
+    // a point needs >= 5 tokens (36 bytes in binary), a curve/surface/volume >= 9 (68 bytes)
+    const auto count = read_entity_counts({10, 36}, {18, 68});
     cur_.end_record("$Entities count");
     for (int d = 0; d < 4; ++d) {
       for (std::int64_t i = 0; i < count[d]; ++i) {
         cur_.begin_record();
         const int tag = cur_.read_int("entity tag");
-        for (int k = 0; k < (d == 0 ? 3 : 6); ++k)
-          cur_.read_real(d == 0 ? "point coordinate" : "bounding box coordinate");
         Entity e;
         read_entity_tail(d, e);
         add_entity(d, tag, std::move(e));
@@ -578,8 +570,25 @@ class GmshReader {
     cur_.expect_end();
   }
 
-  /// The physical tags and bounding entities that end an entity record of dimension d.
+  /// The numbers of points, curves, surfaces and volumes of an ($Partitioned)Entities header;
+  /// a point's record needs at least `point_bytes` bytes, any other's `other_bytes` (ASCII,
+  /// binary), which bounds each count by what the rest of the file can hold.
+  std::array<std::int64_t, 4> read_entity_counts(std::array<std::size_t, 2> point_bytes,
+                                                 std::array<std::size_t, 2> other_bytes) {
+    static constexpr const char* what[] = {"number of points", "number of curves", "number of surfaces",
+                                           "number of volumes"};
+    std::array<std::int64_t, 4> count{};
+    for (int d = 0; d < 4; ++d) {
+      const auto& bytes = d == 0 ? point_bytes : other_bytes;
+      count[std::size_t(d)] = cur_.read_count(what[d], bytes[0], bytes[1]);
+    }
+    return count;
+  }
+
+  /// What ends an entity record of dimension d: the point's coordinates or the bounding box,
+  /// the physical tags and the bounding entities.
   void read_entity_tail(int d, Entity& e) {
+    for (int k = 0; k < (d == 0 ? 3 : 6); ++k) cur_.read_real(d == 0 ? "point coordinate" : "bounding box coordinate");
     const std::int64_t np = cur_.read_count("number of physical tags", 2, 4);
     e.phys.resize(std::size_t(np));
     // a negative tag is the group |tag| holding the entity with reversed orientation (gmsh t14)
@@ -622,12 +631,7 @@ class GmshReader {
       cur_.end_record("ghost entity");
     }
     cur_.begin_record();
-    std::array<std::int64_t, 4> count{};
-    for (int d = 0; d < 4; ++d)
-      count[d] = cur_.read_count(d == 0 ? "number of points" : d == 1 ? "number of curves"
-                                        : d == 2             ? "number of surfaces"
-                                                             : "number of volumes",
-                                 d == 0 ? 16 : 24, d == 0 ? 52 : 84);
+    const auto count = read_entity_counts({16, 52}, {24, 84});
     cur_.end_record("$PartitionedEntities count");
     for (int d = 0; d < 4; ++d) {
       for (std::int64_t i = 0; i < count[d]; ++i) {
@@ -643,8 +647,6 @@ class GmshReader {
             cur_.fail("partition tag " + std::to_string(part) + " is not in [1, " + std::to_string(n_partitions_) + "]");
           if (k == 0) e.partition = part;
         }
-        for (int k = 0; k < (d == 0 ? 3 : 6); ++k)
-          cur_.read_real(d == 0 ? "point coordinate" : "bounding box coordinate");
         read_entity_tail(d, e);
         add_entity(d, tag, std::move(e));
       }

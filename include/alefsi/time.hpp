@@ -5,3 +5,5 @@
 #include "alefsi/time/history.hpp"
 #include "alefsi/time/schemes.hpp"
 #include "alefsi/time/stepper.hpp"
+#include "alefsi/time/error_estimate.hpp"
+#include "alefsi/time/step_controller.hpp"

@@ -180,3 +180,105 @@ TEST_CASE("dispatch_scheme: display or type name to the scheme type, unknown nam
                     Catch::Contains("--scheme") && Catch::Contains("MR/AB, BDF2/BDF2E, BDF2/AB, BDF3/BDF3E, BSS"));
   CHECK(scheme_names() == "MR/AB, BDF2/BDF2E, BDF2/AB, BDF3/BDF3E, BSS");
 }
+
+namespace {
+// One step of scheme S for u' = lambda u from exact past values e^{lambda t} on the history h
+// (BDF of order l: sum_k a_k u^{n+1-k} = dt lambda u^{n+1}; MR/AB: the trapezoidal rule).
+template <TimeScheme S>
+Real one_step(const TimeHistory& h, Real dt, Real lambda, Real t0) {
+  if constexpr (S::theta == 0.5) {
+    return std::exp(lambda * t0) * (1 + dt * lambda / 2) / (1 - dt * lambda / 2);
+  } else {
+    const StepCoefficients c = step_coefficients<S>(dt, h);
+    Real rhs = 0, t = t0;
+    for (int k = 1; k <= c.flow_order; ++k) {
+      rhs -= c.flow_bdf[std::size_t(k)] * std::exp(lambda * t);
+      if (k < c.flow_order) t -= h.step(k - 1);
+    }
+    return rhs / (c.flow_bdf[0] - dt * lambda);
+  }
+}
+// The ratio of the estimate to the true local error of that step.
+template <TimeScheme S>
+Real estimate_ratio(std::initializer_list<Real> past, Real dt, Real lambda) {
+  const TimeHistory h = history(past);
+  const Real t0 = h.now(), u1 = one_step<S>(h, dt, lambda, t0);
+  const ErrorWeights w = error_weights<S>(dt, h);
+  REQUIRE(w.available());
+  Real p = 0, t = t0;
+  for (int k = 0; k < w.points; ++k) {
+    p += w.predictor[std::size_t(k)] * std::exp(lambda * t);
+    if (k + 1 < w.points) t -= h.step(k);
+  }
+  return w.constant * (u1 - p) / (std::exp(lambda * (t0 + dt)) - u1);
+}
+}  // namespace
+
+TEST_CASE("error estimate: the constants C / (E - C) with equal steps", "[time][error][quick]") {
+  const TimeHistory h = history({0.1, 0.1, 0.1});
+  CHECK(error_weights<BDF2_BDF2E>(0.1, h).constant == Approx(-2.0 / 11));
+  CHECK(error_weights<BDF2_AB>(0.1, h).constant == Approx(-2.0 / 11));
+  CHECK(error_weights<BDF3_BDF3E>(0.1, h).constant == Approx(-3.0 / 25));
+  CHECK(error_weights<BSS>(0.1, h).constant == Approx(-1.0 / 3));
+  // MR/AB: the predictor that reproduces quadratics and ignores the (-1)^j mode, 2, 0, -2, 1
+  const ErrorWeights mr = error_weights<MR_AB>(0.1, h);
+  CHECK(mr.constant == Approx(-1.0 / 25));
+  CHECK(mr.predictor[0] == Approx(2));
+  CHECK(std::abs(mr.predictor[1]) < 1e-12);
+  CHECK(mr.predictor[2] == Approx(-2));
+  CHECK(mr.predictor[3] == Approx(1));
+  CHECK(!error_weights<MR_AB>(0.1, history({0.1, 0.1})).available());
+  // the predictor of BDF3 reads four levels: 4, -6, 4, -1
+  const ErrorWeights w = error_weights<BDF3_BDF3E>(0.1, h);
+  CHECK(w.points == 4);
+  CHECK(w.predictor[0] == Approx(4));
+  CHECK(w.predictor[1] == Approx(-6));
+  CHECK(w.predictor[2] == Approx(4));
+  CHECK(w.predictor[3] == Approx(-1));
+  // too few levels: no estimate
+  CHECK(!error_weights<BDF3_BDF3E>(0.1, history({0.1, 0.1})).available());
+  CHECK(error_weights<BSS>(0.1, history({0.1})).available());
+}
+
+TEMPLATE_TEST_CASE("error estimate: the estimate over the true local error tends to 1, equal and unequal steps",
+                   "[time][error][quick]", MR_AB, BDF2_BDF2E, BDF2_AB, BDF3_BDF3E, BSS) {
+  for (Real lambda : {1.0, -2.0}) {
+    Real prev = 1, prev_equal = 1;
+    for (Real dt : {0.04, 0.02, 0.01}) {
+      const Real equal = estimate_ratio<TestType>({dt, dt, dt, dt}, dt, lambda);
+      const Real unequal = estimate_ratio<TestType>({dt, 1.3 * dt, 0.8 * dt, 1.1 * dt}, 0.7 * dt, lambda);
+      INFO(TestType::name << " lambda " << lambda << " dt " << dt << ": ratio " << equal << " (equal), " << unequal
+                          << " (unequal)");
+      // the ratio is 1 + O(dt): its distance from 1 halves with dt
+      CHECK(std::abs(equal - 1) < 0.2);
+      CHECK(std::abs(unequal - 1) < 0.2);
+      if (dt < 0.04) CHECK(std::abs(unequal - 1) < 0.6 * prev);
+      if (dt < 0.04) CHECK(std::abs(equal - 1) < 0.6 * prev_equal);
+      prev = std::abs(unequal - 1), prev_equal = std::abs(equal - 1);
+    }
+  }
+}
+
+TEST_CASE("PI step controller: converges to the step that meets the tolerance, clips, shrinks on rejection",
+          "[time][error][quick]") {
+  // a model error r = (dt / dt*)^k, k = q + 1 = 3 (dt* meets the tolerance exactly): the
+  // controller settles at r = safety, dt = safety^(1/k) dt*
+  PiStepController pi(2, max_step_ratio<BDF2_BDF2E>());
+  const Real dt_star = 1e-2;
+  Real dt = 1e-4;
+  for (int n = 0; n < 80; ++n) dt = pi.accepted(dt, true, std::pow(dt / dt_star, 3.0));
+  CHECK(dt / dt_star == Approx(std::cbrt(PiStepController::safety)).epsilon(1e-6));
+  CHECK(pi.last_error() == Approx(PiStepController::safety).epsilon(1e-5));
+  // growth clipped at the zero-stability bound (2 for BDF2), never above 1 after a rejection
+  PiStepController fresh(2, 2.0);
+  CHECK(fresh.accepted(1.0, true, 1e-12) < 2.0);
+  CHECK(fresh.accepted(1.0, true, 1e-12) == Approx(2.0).epsilon(1e-8));
+  CHECK(fresh.accepted(1.0, true, 1e-12, true) <= 1.0);
+  PiStepController bdf3(3, max_step_ratio<BDF3_BDF3E>());
+  CHECK(bdf3.accepted(1.0, true, 1e-12) < 1.5);
+  // no estimate: dt kept; rejection: shrink by safety r^(-1/k), at least to 0.2
+  CHECK(pi.accepted(0.5, false, 0) == 0.5);
+  CHECK(pi.rejected(1.0, 8.0) == Approx(std::cbrt(0.9 / 8)));
+  CHECK(pi.rejected(1.0, 1e6) == Approx(0.2));
+  CHECK_THROWS_AS(PiStepController(0, 2.0), InvalidArgument);
+}

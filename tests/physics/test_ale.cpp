@@ -10,6 +10,7 @@
 #include "alefsi/fem/norms.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
 #include "alefsi/sim/ale_flow.hpp"
+#include "alefsi/sim/driver.hpp"
 
 using namespace alefsi;
 using std::numbers::pi;
@@ -107,6 +108,28 @@ Real run_mms(int steps, Real T, bool elastic, int n_mesh = 4, Linearisation lin 
       flow.space(), flow.field(), [&](const Vec<D>& x) { return Ex::u(x, T); },
       [&](const Vec<D>& x) { return Mat<D>(g(T) * Ex::shape_grad(x)); }, [&](const Vec<D>& x) { return Ex::p(x, T); });
   return e.u_l2;
+}
+
+// The same flow, run adaptively to T by run() with the error tolerance `tol` from a first step
+// of 1e-3; returns the L2 velocity error at T and the number of steps.
+template <class Pair, class Scheme>
+std::pair<Real, int> run_mms_adaptive(Real tol, Real T = 1.0) {
+  constexpr int D = 2;
+  using Ex = Exact<D, Pair>;
+  AleFlow<FlowConfig<D, Pair, Scheme>> flow(unit_mesh<D>(4), FlowOptions{rho, mu, Linearisation::newton, 25, 1e-13});
+  for (int t = 1; t <= 2 * D; ++t) flow.set_velocity(t, Ex::u);
+  flow.set_prescribed_mesh_velocity(wobble<D>);
+  flow.set_force(Ex::f);
+  flow.set_initial_velocity([](const Vec<D>& x) { return Ex::u(x, 0.0); });
+  RunOptions ro;
+  ro.dt = 1e-5, ro.t_end = T, ro.tolerance = tol, ro.progress_every = 0, ro.log = nullptr;
+  const RunSummary sum = run(flow, ro);
+  CHECK(flow.time() == Approx(T).epsilon(1e-14));
+  CHECK(flow.stats().history_restarts == 0);
+  const auto e = flow_errors<D, Pair>(
+      flow.space(), flow.field(), [&](const Vec<D>& x) { return Ex::u(x, T); },
+      [&](const Vec<D>& x) { return Mat<D>(g(T) * Ex::shape_grad(x)); }, [&](const Vec<D>& x) { return Ex::p(x, T); });
+  return {e.u_l2, sum.steps};
 }
 
 template <int D, class Pair, class Scheme>
@@ -303,4 +326,56 @@ TEST_CASE("a step whose Newton iteration fails is rejected and leaves the state 
   CHECK(flow.field() == u0);
   for (Index i = 0; i < flow.mesh().n_nodes(); ++i) CHECK(flow.mesh().node(i) == x0[i]);
   REQUIRE_THROWS_AS(flow.step(-1.0), InvalidArgument);
+}
+
+// Adaptive steps (run() with RunOptions::tolerance): the controller holds the estimated local
+// error per step at the tolerance, so the steps scale as tol^(1/(q+1)) and the error at T as
+// tol^(q/(q+1)) (tolerance proportionality, Hairer, Norsett & Wanner I, II.4): the estimate
+// (time/error_estimate.hpp) measures the scheme's real local error.
+TEMPLATE_TEST_CASE("adaptive steps: the error at T is proportional to tol^(q/(q+1)), the step count to tol^(-1/(q+1))",
+                   "[ale][adaptive][convergence]", BDF2_BDF2E, BDF2_AB, BDF3_BDF3E, BSS) {
+  constexpr int q = TestType::order;
+  const std::vector<Real> tols = q == 1 ? std::vector<Real>{1e-3, 1e-4, 1e-5} : std::vector<Real>{1e-5, 1e-6, 1e-7};
+  std::vector<Real> err;
+  std::vector<int> steps;
+  for (Real tol : tols) {
+    const auto [e, n] = run_mms_adaptive<TaylorHood, TestType>(tol);
+    err.push_back(e), steps.push_back(n);
+  }
+  std::cout << "adaptive " << TestType::name << ":";
+  for (std::size_t k = 0; k < tols.size(); ++k) std::cout << " tol " << tols[k] << " e " << err[k] << " steps " << steps[k];
+  const Real p_err = std::log10(err[1] / err[2]), p_steps = std::log10(Real(steps[2]) / steps[1]);
+  std::cout << "; error ~ tol^" << p_err << ", steps ~ tol^-" << p_steps << "\n";
+  CHECK(p_err == Approx(Real(q) / (q + 1)).margin(0.1));
+  CHECK(p_steps == Approx(1.0 / (q + 1)).margin(0.1));
+}
+
+// MR/AB under steps that jump (1.2, 0.8, 1.2, ... times T/N, not a smooth sequence): the jumps
+// excite the midpoint rule's undamped (-1)^n mode and the scheme is only first order (BDF2 keeps
+// its second order on the same sequence); run() refuses it for adaptive steps.
+TEST_CASE("MR/AB is first order when the steps jump; adaptive runs refuse it", "[ale][adaptive][convergence]") {
+  auto jumpy = [](auto scheme, int N) {
+    using S = decltype(scheme);
+    using Ex = Exact<2, TaylorHood>;
+    AleFlow<FlowConfig<2, TaylorHood, S>> flow(unit_mesh<2>(4), FlowOptions{rho, mu, Linearisation::newton, 25, 1e-13});
+    for (int t = 1; t <= 4; ++t) flow.set_velocity(t, Ex::u);
+    flow.set_prescribed_mesh_velocity(wobble<2>);
+    flow.set_force(Ex::f);
+    flow.set_initial_velocity([](const Vec<2>& x) { return Ex::u(x, 0.0); });
+    for (int n = 0; n < N; ++n) flow.step((n % 2 ? 0.8 : 1.2) / N);
+    const Real T = flow.time();
+    return flow_errors<2, TaylorHood>(
+               flow.space(), flow.field(), [&](const Vec<2>& x) { return Ex::u(x, T); },
+               [&](const Vec<2>& x) { return Mat<2>(g(T) * Ex::shape_grad(x)); }, [&](const Vec<2>& x) { return Ex::p(x, T); })
+        .u_l2;
+  };
+  const Real mr = std::log2(jumpy(MR_AB{}, 40) / jumpy(MR_AB{}, 80));
+  const Real bdf2 = std::log2(jumpy(BDF2_BDF2E{}, 40) / jumpy(BDF2_BDF2E{}, 80));
+  std::cout << "jumping steps: MR/AB rate " << mr << ", BDF2/BDF2E rate " << bdf2 << "\n";
+  CHECK(mr == Approx(1.0).margin(0.15));
+  CHECK(bdf2 > 1.7);
+  AleFlow<FlowConfig<2, TaylorHood, MR_AB>> flow(unit_mesh<2>(2), FlowOptions{rho, mu});
+  RunOptions ro;
+  ro.t_end = 0.1, ro.tolerance = 1e-4, ro.log = nullptr;
+  CHECK_THROWS_WITH(run(flow, ro), Catch::Contains("tolerance") && Catch::Contains("not L-stable"));
 }

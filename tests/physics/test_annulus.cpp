@@ -369,7 +369,7 @@ TEST_CASE("damped start: checkpoint + restart continues bit for bit, across a da
   // BDF3/BDF3E (extrapolated damped start, then an MR/AB start-up step), free inner cylinder;
   // the dt change after the checkpoint restarts the history, with a damped start again.
   using Flow = AleFlow<FlowConfig<2, TaylorHood, BDF3_BDF3E>>;
-  const FlowOptions opt{1.0, 1.0, Linearisation::newton, 25, 1e-10, 4};
+  const FlowOptions opt{1.0, 1.0, Linearisation::newton, 25, 1e-10, 4, /*variable_steps=*/false};
   auto configure = [](Flow& flow) { scenes::Annulus{.external_load = Vec<3>(0, 0, 0.3)}.configure(flow); };
   Flow straight(annulus_mesh(0.25, 1.0, 3, 32), opt);
   configure(straight);

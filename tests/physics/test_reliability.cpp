@@ -2,6 +2,8 @@
 // exactly, checkpoints that refuse to be wrong, Newton at any dt.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -38,9 +40,10 @@ std::unique_ptr<Annulus> annulus_flow(Mesh<2> mesh) {
   scenes::Annulus{}.configure(*flow);
   return flow;
 }
+// a fixed dt (tolerance 0), silent
 RunOptions quiet(Real dt, Real t_end) {
   RunOptions ro;
-  ro.dt = dt, ro.t_end = t_end, ro.progress_every = 0, ro.log = nullptr;
+  ro.dt = dt, ro.t_end = t_end, ro.tolerance = 0, ro.progress_every = 0, ro.log = nullptr;
   return ro;
 }
 }  // namespace
@@ -62,6 +65,34 @@ TEST_CASE("time is counted, not summed: t_end on the step grid is reached by ste
   CHECK(run(*off, quiet(0.01, 0.1005)).steps == 10);
   CHECK(off->time() == Approx(0.1005).epsilon(1e-15));
   CHECK(run(*off, quiet(0.01, 0.1205)).steps == 2);
+}
+
+TEST_CASE("adaptive by default for the BDF schemes: the steps land on t_end and on land_on times",
+          "[reliability][adaptive][quick]") {
+  RunOptions ro;
+  CHECK(ro.tolerance_for<BDF2_BDF2E>(true) == RunOptions::default_tolerance);
+  CHECK(ro.tolerance_for<BDF3_BDF3E>(false) == 0);  // without variable steps: a fixed dt
+  CHECK(ro.tolerance_for<MR_AB>(true) == 0);        // not L-stable: a fixed dt
+  ro.tolerance = 0;
+  CHECK(ro.tolerance_for<BDF2_BDF2E>(true) == 0);
+  auto flow = annulus_flow(annulus_mesh(0.25, 1.0, 2, 16));  // the inner cylinder spins up from rest
+  std::vector<Real> times;
+  RunOptions a;
+  a.dt = 1e-4, a.t_end = 0.3, a.land_on = {0.05, 0.123}, a.progress_every = 0, a.log = nullptr;
+  a.on_step = [&] { times.push_back(flow->time()); };
+  const RunSummary s = run(*flow, a);
+  CHECK(flow->time() == Approx(0.3).epsilon(1e-15));
+  for (Real t_land : a.land_on)
+    CHECK(std::count_if(times.begin(), times.end(), [&](Real t) { return std::abs(t - t_land) < 1e-14; }) == 1);
+  CHECK(s.dt_largest > 10 * s.dt_smallest);
+  CHECK(s.steps < 300);  // against 3000 fixed steps of the first dt
+  CHECK(flow->stats().history_restarts == 0);
+  CHECK_THROWS_WITH(run(*flow, [&] {
+                      RunOptions bad = a;
+                      bad.t_end = 0.4, bad.land_on = {std::nan("")};
+                      return bad;
+                    }()),
+                    Catch::Contains("land_on"));
 }
 
 TEST_CASE("Newton stops at any dt: a step of 1e-13 s converges by the scaled residual", "[reliability][quick]") {
@@ -116,6 +147,49 @@ TEST_CASE("a run to T1 continued from its final checkpoint to T2 is the run to T
   int rows = -1;
   for (std::string line; std::getline(csv, line);) ++rows;
   CHECK(rows == 30);
+}
+
+TEST_CASE("an adaptive run continued from a checkpoint is the uninterrupted run, bit for bit, across remeshes",
+          "[reliability][checkpoint][adaptive][quick]") {
+  using Dkt = AleFlow<FlowConfig<2, P1P1Gls, BDF2_BDF2E>>;
+  const auto scene = scenes::SettlingDisks::dkt(0.01);
+  const Real hb = 0.03, hf = 0.3;
+  auto make = [&](Mesh<2> mesh) {
+    auto flow = std::make_unique<Dkt>(std::move(mesh), FlowOptions{.rho = 1, .mu = 0.01,
+                                                                  .linearisation = Linearisation::semi_implicit, .tau_dt = 2e-3});
+    scene.configure(*flow, hb, hf);
+    return flow;
+  };
+  TempDir dir("alefsi_test_continue_adaptive");
+  RunOptions ro;  // the default: adaptive, from a first step of 1e-4
+  ro.dt = 1e-4, ro.t_end = 0.08, ro.land_on = {0.04}, ro.progress_every = 0, ro.log = nullptr;
+  REQUIRE(ro.tolerance_for<BDF2_BDF2E>(true) == RunOptions::default_tolerance);
+  auto straight = make(scene.mesh(2 * hb, hf));  // coarser than the size function wants: it remeshes
+  const RunSummary all = run(*straight, ro);
+  REQUIRE(straight->stats().remeshes > 1);
+  REQUIRE(all.dt_largest > 10 * all.dt_smallest);  // the steps did vary
+
+  RunOptions first = ro;
+  first.t_end = 0.04, first.output = dir.path, first.checkpoint_every = 1000;  // only the final checkpoint
+  auto part = make(scene.mesh(2 * hb, hf));
+  const RunSummary a = run(*part, first);
+  REQUIRE(a.remeshes > 0);
+  auto continued = make(read_checkpoint_mesh<2>(dir.path / "checkpoint.bin"));
+  continued->load_checkpoint(dir.path / "checkpoint.bin");
+  CHECK(continued->time() == 0.04);
+  RunOptions second = first;
+  second.t_end = 0.08;
+  const RunSummary b = run(*continued, second);
+  CHECK(straight->stats().remeshes > a.remeshes);  // remeshes after the checkpoint too
+  CHECK(a.steps + b.steps == all.steps);
+  CHECK(continued->time() == straight->time());
+  REQUIRE(continued->mesh().n_nodes() == straight->mesh().n_nodes());
+  CHECK(continued->mesh().coordinates() == straight->mesh().coordinates());
+  CHECK(continued->field() == straight->field());
+  for (std::size_t k = 0; k < 2; ++k) {
+    CHECK(continued->body_centre(k) == straight->body_centre(k));
+    CHECK(continued->body_velocity(k) == straight->body_velocity(k));
+  }
 }
 
 TEST_CASE("a checkpoint that is not exactly what was written, or was written by another flow, is refused",

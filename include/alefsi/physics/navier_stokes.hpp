@@ -43,6 +43,9 @@ enum class Linearisation { newton, semi_implicit };
 template <int D>
 struct StepInputs {
   Real dt = 1, theta = 1, a0 = 1;
+  /// The step in tau's transient term (`gls_tau`); 0: dt. A fixed value keeps the stabilised
+  /// operator from changing with dt (adaptive steps; FlowOptions::tau_dt).
+  Real tau_dt = 0;
   const VecX* history = nullptr;     ///< field vector, velocity entries: sum_{k>=1} a_k u^{n+1-k}
   const VecX* previous = nullptr;    ///< u^n (field vector), used when theta < 1
   const VecX* extrapolated = nullptr;///< u* (field vector): convecting velocity / tau
@@ -91,7 +94,7 @@ class AleNavierStokesKernel {
   /// The GLS parameter `gls_tau` of cell c at the current step for the convecting velocity
   /// a_star (ignored without convection), whatever the pair (a stable pair does not use it).
   Real tau(Index c, const Vec<D>& a_star) const {
-    return gls_tau({.h = space_->mesh().diameter(c), .mu = mu_, .rho = rho_, .dt = s_.dt,
+    return gls_tau({.h = space_->mesh().diameter(c), .mu = mu_, .rho = rho_, .dt = s_.tau_dt > 0 ? s_.tau_dt : s_.dt,
                     .a_norm = Convection ? a_star.norm() : 0.0});
   }
 
@@ -121,7 +124,7 @@ class AleNavierStokesKernel {
       for (int a = 0; a <= D; ++a) Vm.row(a) = (*s_.mesh_velocity)[mesh.cell(c)[a]].transpose();
     const typename Stabilisation::Cell local{.mesh = mesh, .c = c, .Jinv = Jinv, .detJ = detJ, .U = U, .Uth = Uth,
                                              .H = H, .Us = Us, .Vm = Vm, .Pl = Pl, .dt = dt, .theta = th, .a0 = a0,
-                                             .newton = newton};
+                                             .tau_dt = s_.tau_dt > 0 ? s_.tau_dt : dt, .newton = newton};
     const Real tau_c = stab_.tau(local);
     // --- velocity-velocity block, from reference integrals (no quadrature) --------------------
     // Per component pair (i, j) an nv x nv array over (a, b) (lane a + nv b):

@@ -141,6 +141,7 @@ struct NavierStokesCell {
   const Eigen::Matrix<Real, D + 1, D>& Vm;  ///< mesh velocity at the D + 1 vertices, at n + theta
   const Eigen::Matrix<Real, np, 1>& Pl;     ///< pressure p^{n+theta}
   Real dt, theta, a0;
+  Real tau_dt;  ///< the step in tau's transient term (dt, or a fixed one: StepInputs::tau_dt)
   bool newton;  ///< convection linearised by Newton (c = u_th), not semi-implicitly (c = u*)
 };
 
@@ -193,7 +194,7 @@ class NavierStokesStabilisation<D, Pair, Convection, GlsStabilisation> {
     const Vec<D> xi_c = Vec<D>::Constant(1.0 / (D + 1));
     const auto phic = V::values(xi_c);
     Vec<D> a_star = (l.Us.transpose() * phic) - l.Vm.transpose() * P1<D>::values(xi_c);
-    return gls_tau({.h = l.mesh.diameter(l.c), .mu = mu_, .rho = rho_, .dt = l.dt,
+    return gls_tau({.h = l.mesh.diameter(l.c), .mu = mu_, .rho = rho_, .dt = l.tau_dt,
                     .a_norm = Convection ? a_star.norm() : 0.0});
   }
 

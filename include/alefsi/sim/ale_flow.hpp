@@ -54,6 +54,7 @@
 #include "alefsi/sim/newton.hpp"
 #include "alefsi/sim/remesher.hpp"
 #include "alefsi/sim/remesher2d.hpp"
+#include "alefsi/time/error_estimate.hpp"
 #include "alefsi/time/stepper.hpp"
 
 namespace alefsi {
@@ -63,6 +64,9 @@ struct StepReport {
   std::vector<Real> residuals;  ///< max-norm residual before each Newton update
   bool startup = false;   ///< a start-up step (MR/AB, or a damped start)
   bool remeshed = false;  ///< the mesh was adapted after the step
+  /// The local error estimate of a regular step (time/error_estimate.hpp); none for start-up
+  /// steps.
+  ErrorEstimate error;
   /// Wall time (s) of the step's phases: mesh-velocity solve, assembly (all Newton
   /// iterations), numeric factorisation (incl. the one-off symbolic analysis), triangular
   /// solves, adaptation + transfer + rebuild.
@@ -111,6 +115,14 @@ class AleFlow {
   Solver& solver() { return disc_.linear_solve().solver(); }
   const State& state() const { return state_; }
   const FlowStats& stats() const { return state_.stats; }
+  /// Whether a change of dt keeps the history (FlowOptions::variable_steps).
+  bool variable_steps() const { return stepper_.variable_steps(); }
+  /// What the time loop's step-size controller remembers: the next step and the last scaled
+  /// error; kept in checkpoints (sim/driver.hpp).
+  void set_step_control(Real next_dt, Real last_error) {
+    state_.control.next_dt = next_dt, state_.control.last_error = last_error;
+  }
+  const FlowOptions& options() const { return opt_; }
   std::size_t n_bodies() const { return bodies_.size(); }
   Real time() const { return state_.time.now(); }
   /// u^n and p^n (p at the scheme's level n - 1 + theta) as a field vector (MixedSpace layout).
@@ -209,8 +221,10 @@ class AleFlow {
   void prepare() {
     if (!disc_.constrained()) setup();
   }
-  /// Advances from t^n to t^n + dt.
-  StepReport step(Real dt) {
+  /// Advances from t^n to t^n + dt. With `control.tolerance` > 0, a regular step whose error
+  /// estimate exceeds it is rejected before anything changes: `StepRejected` is thrown and the
+  /// flow stays at t^n.
+  StepReport step(Real dt, const ErrorControl& control = {}) {
     ALEFSI_CHECK_ARG(dt > 0 && std::isfinite(dt), "dt", "time step must be positive and finite, got ", dt);
     prepare();
     if (stepper_.restarts(state_.time, dt)) {
@@ -219,9 +233,12 @@ class AleFlow {
     }
     const StepPlan plan = stepper_.plan(state_.time, dt);
     if (state_.time.levels() == 0 && plan.kind != StepKind::damped_start) start_mesh_velocity();
-    StepReport rep = plan.kind == StepKind::damped_start ? damped_start(plan, dt) : advance(plan.coefficients);
+    StepReport rep = plan.kind == StepKind::damped_start ? damped_start(plan, dt)
+                     : plan.kind == StepKind::startup  ? advance(plan.coefficients)
+                                                       : advance(plan.coefficients, &control);
     rep.startup = plan.kind != StepKind::regular;
     ++state_.stats.steps;
+    if (state_.control.steps_since_remesh >= 0) ++state_.control.steps_since_remesh;
     if (remesher_ && remesher_->enabled()) {
       const auto t0 = std::chrono::steady_clock::now();
       if (remesher_->needed(mesh_, bodies_.remesh_bodies(state_.bodies), state_.remesh)) rep.remeshed = remesh();
@@ -245,6 +262,7 @@ class AleFlow {
     setup();
     bodies_.reset_surface_velocities(space(), state_.bodies, state_.X, state_.U);
     ++state_.stats.remeshes;
+    state_.control.steps_since_remesh = 0;
     state_.remesh = remesher_->measure(mesh_, bodies_.remesh_bodies(state_.bodies));
     return true;
   }
@@ -327,8 +345,9 @@ class AleFlow {
     state_.V = mesh_velocity_.solve(disc_.motion(), mesh_, state_.X[0], time(), body_nodes_);
   }
 
-  // One step with the coefficients c (steps 1-5 of the file comment).
-  StepReport advance(const StepCoefficients& c) {
+  // One step with the coefficients c (steps 1-5 of the file comment); with `control` (regular
+  // steps) the error is estimated, and the step rejected if it exceeds the tolerance.
+  StepReport advance(const StepCoefficients& c, const ErrorControl* control = nullptr) {
     State& s = state_;
     const Real t = s.time.now(), t1 = t + c.dt;
     if (c.backfill) backfill(s, c.dt);
@@ -351,6 +370,13 @@ class AleFlow {
       VecX field = disc_.constraints().expand(u);
       bodies_.driven_loads(s.bodies, space(), disc_.kernel(), field, c, Xth);
       if (disc_.pressure_pinned()) shift_pressure_to_zero_mean(space(), field);
+      if (control) {
+        rep.error = estimate_error(c.dt, field, u, t1);
+        if (const Real e = rep.error.scaled(*control); e > 1)
+          throw StepRejected("local error " + detail::sci(e) + " times the tolerance in the step from t = " +
+                                 detail::sci(t) + " with dt = " + detail::sci(c.dt),
+                             e);
+      }
       mesh_.set_coordinates(g.Xn1);
       // 5. the new level
       bodies_.finish(s.bodies, c, disc_.constraints(), u, t1, gravity_);
@@ -363,6 +389,43 @@ class AleFlow {
       throw;
     }
     return rep;
+  }
+
+  // The error estimate of the step from t^n to t1 = t^n + dt whose new field is `field` (`u` its
+  // unknowns), before the state takes it (time/error_estimate.hpp).
+  ErrorEstimate estimate_error(Real dt, const VecX& field, const VecX& u, Real t1) const {
+    const State& s = state_;
+    const ErrorWeights w = error_weights<Scheme>(dt, s.time);
+    ErrorEstimate est;
+    if (!w.available()) return est;
+    // the levels read must be computed on this mesh, not interpolated by a remesh
+    if (s.control.steps_since_remesh >= 0 && s.control.steps_since_remesh < w.points) return est;
+    for (int k = 0; k < w.points; ++k)
+      if (s.U[k].size() != field.size()) return est;  // a level not taken yet
+    est.available = true;
+    const auto& vel = space().velocity();
+    for (Index i = 0; i < vel.n_dofs(); ++i)
+      for (int d = 0; d < D; ++d) {
+        const Index j = space().velocity_field(i, d);
+        Real p = 0;
+        for (int k = 0; k < w.points; ++k) p += w.predictor[std::size_t(k)] * s.U[k][j];
+        est.velocity = std::max(est.velocity, std::abs(w.constant * (field[j] - p)));
+        est.scale = std::max(est.scale, std::abs(field[j]));
+      }
+    for (std::size_t b = 0; b < s.bodies.size(); ++b) {
+      if (!bodies_.is_free(b)) continue;
+      const auto& body = s.bodies[b];
+      Real L = 0;
+      for (const Vec<D>& r : body.surface) L = std::max(L, r.norm());
+      const BodyVelocity Z = bodies_.next_velocity(b, disc_.constraints(), u, t1);
+      BodyVelocity P = BodyVelocity::Zero();
+      for (int k = 0; k < w.points; ++k) P += w.predictor[std::size_t(k)] * body.velocity[k];
+      const BodyVelocity e = w.constant * (Z - P);
+      constexpr int nw = body_dofs - D;
+      est.body = std::max(est.body, e.template head<D>().norm() + L * e.template tail<nw>().norm());
+      est.scale = std::max(est.scale, Z.template head<D>().norm() + L * Z.template tail<nw>().norm());
+    }
+    return est;
   }
 
   // Step 4: Dirichlet data and body links at t1, the kernel's inputs, the contacts, Newton;

@@ -259,7 +259,9 @@ class BodySystem {
       Vec<D> xs = c.dt * e.Zhat.template head<D>();
       for (int l = 1; l <= c.position_order; ++l) xs -= b[l] * s.centre[l - 1];
       e.xg_next = xs / b[0];
-      e.th_next = M::advance(s.orientation.at, e.Zhat, b, c.position_order, c.dt);
+      // the position formula reads at most levels n .. n-2
+      const std::array<Orientation, 3> th{s.orientation[0], s.orientation[1], s.orientation[2]};
+      e.th_next = M::advance(th, e.Zhat, b, c.position_order, c.dt);
       for (std::size_t j = 0; j < e.nodes.size(); ++j)
         Xn1[e.nodes[j]] = e.xg_next + M::to_world(s.surface[j], e.th_next, e.data);
     }
@@ -351,6 +353,16 @@ class BodySystem {
     });
   }
 
+  /// Whether body k is free (its velocity solved for) rather than driven.
+  bool is_free(std::size_t k) const { return M::is_free(entries_.at(k).data); }
+  /// Z^{n+1} of body k after the solve (`u` the unknowns at t1): its unknowns if it is free,
+  /// its prescribed velocity at t1 if it is driven.
+  Velocity next_velocity(std::size_t k, const DofConstraints& cons, const VecX& u, Real t1) const {
+    const auto& e = entries_.at(k);
+    return M::is_free(e.data) ? Velocity(u.template segment<n_dof>(cons.extra_unknown(e.extra)))
+                              : Velocity(M::prescribed_velocity(e.data, t1));
+  }
+
   /// After the solve (`u` the unknowns at t^{n+1} = t1): Z^{n+1} of every body, the hydrodynamic
   /// load of the free ones from their momentum balance (M delta_l Z / dt (+ w x I_w w) - M g -
   /// external load - contact force), and the new level of each body's history.
@@ -360,8 +372,7 @@ class BodySystem {
       const auto& e = entries_[k];
       State& s = states[k];
       const bool free = M::is_free(e.data);
-      const Velocity Zn1 = free ? Velocity(u.template segment<n_dof>(cons.extra_unknown(e.extra)))
-                                : Velocity(M::prescribed_velocity(e.data, t1));
+      const Velocity Zn1 = next_velocity(k, cons, u, t1);
       if (free) {
         s.load = inertia(e, s, c, Zn1) - weight(e, gravity) - M::external_load(e.data);
         s.load.template head<D>() -= s.contact;

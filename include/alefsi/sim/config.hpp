@@ -98,21 +98,31 @@ struct FlowOptions {
   /// t^n + dt (equal spacing dt); a scheme that needs more levels continues with its MR/AB
   /// start-up steps.
   int damped_start = 0;
-  /// Variable steps: a step of another dt than the last keeps the history and uses the
-  /// variable-step formulas (time/stepper.hpp), unless it grows by more than the scheme's
-  /// step-ratio bound (2 for BDF2, 1.5 for BDF3: max_step_ratio), which restarts it. false
-  /// (default): every change of dt restarts the history (start-up formulas).
-  bool variable_steps = false;
+  /// Variable steps (default): a step of another dt than the last keeps the history and uses
+  /// the variable-step formulas (time/stepper.hpp), unless it grows by more than the scheme's
+  /// step-ratio bound (2 for BDF2, 1.5 for BDF3: max_step_ratio), which restarts it; adaptive
+  /// runs (RunOptions::tolerance) need it. false: every change of dt restarts the history
+  /// (start-up formulas), the paper's constant-step procedure. With equal steps both are the
+  /// same, bit for bit.
+  bool variable_steps = true;
   /// Threads of the flow system's assembly (Assembler::set_threads; default 1). Results are
   /// bit-identical for every count. With more than one, the user's force callback
   /// (set_force) is called concurrently and must be safe to call so (a pure function is).
   int threads = 1;
+  /// Stabilised pairs (P1/P1-GLS): the step in tau_K's transient term (2 rho / dt)^2. 0
+  /// (default): each step's dt, as the paper. The stabilised operator then changes with dt
+  /// (as dt -> 0, tau -> dt / (2 rho)), so a change of dt moves the discrete solution by a
+  /// spatial, not a temporal, amount that the error estimate of adaptive runs reads as a
+  /// step error; adaptive runs (RunOptions::tolerance) of a stabilised pair need a fixed value
+  /// here, e.g. the nominal step (run() refuses them otherwise). Ignored by stable pairs.
+  Real tau_dt = 0;
 
   void validate() const {
     ALEFSI_CHECK_ARG(rho >= 0 && std::isfinite(rho), "rho", "fluid density must be >= 0 and finite, got ", rho);
     ALEFSI_CHECK_ARG(mu > 0 && std::isfinite(mu), "mu", "viscosity must be positive and finite, got ", mu);
     ALEFSI_CHECK_ARG(max_newton >= 1, "max_newton", "must be >= 1");
     ALEFSI_CHECK_ARG(threads >= 1, "threads", "must be at least 1, got ", threads);
+    ALEFSI_CHECK_ARG(tau_dt >= 0 && std::isfinite(tau_dt), "tau_dt", "must be >= 0 (0: each step's dt), got ", tau_dt);
     ALEFSI_CHECK_ARG(damped_start == 0 || (damped_start >= 2 && damped_start <= 64 && damped_start % 2 == 0),
                      "damped_start", "must be 0 (off) or an even number of substeps in 2..64, got ", damped_start);
   }

@@ -106,7 +106,7 @@ class Discretisation {
     for (int k = 0; k < 3; ++k)
       if (c.convection[k] != 0) ustar_ += c.convection[k] * U[k];
     StepInputs<D> in;
-    in.dt = c.dt, in.theta = c.theta, in.a0 = c.flow_bdf[0];
+    in.dt = c.dt, in.theta = c.theta, in.a0 = c.flow_bdf[0], in.tau_dt = opt_.tau_dt;
     in.history = &hist_, in.previous = &U[0], in.extrapolated = &ustar_, in.mesh_velocity = &Vflow;
     in.force = std::move(force);
     kernel_->set_step(in);

@@ -4,22 +4,37 @@
 /// output, a CSV time series of every body, atomic checkpoints, and rejection of failed
 /// steps with a smaller dt.
 ///
-/// `run(flow, options)` advances from flow.time() to options.t_end:
-///  * each step: `flow.step(dt)`; if it throws SolverError (Newton did not converge, NaN) or
-///    MeshError (a cell would invert), the flow is still at t^n (AleFlow guarantees it), so
-///    the step is retried with dt / 2, up to `max_retries` halvings; after `recover_after`
-///    good steps the driver tries twice the dt again, up to the nominal one. Each change of dt
-///    restarts the multistep history (AleFlow). If the retries run out, `run` writes a
+/// `run(flow, options)` advances from flow.time() to options.t_end, in one of two modes:
+///  * adaptive steps (the default for the BDF schemes on a flow with
+///    FlowOptions::variable_steps; `tolerance` > 0): `dt` is the first step; each regular step
+///    is checked by its local error estimate (time/error_estimate.hpp) against `tolerance`
+///    times the flow's velocity scale; a step above it is rejected (StepRejected, the flow stays
+///    at t^n) and retried smaller; the next step comes from Söderlind's PI controller
+///    (time/step_controller.hpp), within the scheme's step-ratio bound. Events shrink it: a free
+///    body travels at most `travel` of its gap (to a body or a wall) per step, so collisions are
+///    approached in small steps; a step after a remesh does not grow; `dt_max` caps it. Steps
+///    land exactly on `land_on` times and on t_end (the step before is shortened, or the rest
+///    split in two when shortening would leave a sliver). The controller's memory (next dt,
+///    last error) is part of the flow's state, so a run continued from a checkpoint is bit for
+///    bit the uninterrupted one. MR/AB is refused (its undamped (-1)^n mode makes it first order
+///    under step changes); `tolerance = 0` gives it, or any scheme, a fixed dt.
+///  * fixed dt (`tolerance = 0`, MR/AB by default): every step is `dt`.
+/// In both, if a step throws SolverError (Newton did not converge, NaN) or MeshError (a cell
+///    would invert), the flow is still at t^n (AleFlow guarantees it), so
+///    the step is retried with dt / 2, up to `max_retries` halvings; with a fixed dt, after
+///    `recover_after` good steps the driver tries twice the dt again, up to the nominal one
+///    (each change of dt restarts the multistep history unless the flow has variable steps).
+///    If the retries run out, `run` writes a
 ///    checkpoint of the last good state (when checkpoints are on) and throws Error naming t,
 ///    dt and the last failure; what was written until then stays valid.
-///  * the end: the flow counts its time (t = t_a + k dt, time/history.hpp), so a t_end on the
+///  * the end of a fixed-dt run: the flow counts its time (t = t_a + k dt, time/history.hpp), so a t_end on the
 ///    step grid is reached by steps of dt exactly, the last one included (no sliver, no
 ///    start-up step at the end). Off the grid, a remainder of up to `absorb` dt is taken into
 ///    the last step (one step of up to (1 + absorb) dt), a larger one is a last, shorter step.
 ///    A run to T1 continued from its final checkpoint to T2 is then bit for bit the run to T2
 ///    (for T1 on the grid, and no step being retried at T1).
 ///  * output (when `output` is set): `<output>/bodies.csv` (one row per step: t, dt, Newton
-///    iterations, remeshed, worst quality, then per body k: the centre (x, y[, z]), the
+///    iterations, remeshed, worst quality, the scaled error estimate (0: none), then per body k: the centre (x, y[, z]), the
 ///    orientation (2D: angle; 3D: quaternion qw, qx, qy, qz), the velocity Z (2D: vx, vy,
 ///    omega; 3D: vx, vy, vz, wx, wy, wz), the hydrodynamic load (2D: fx, fy, torque; 3D: fx,
 ///    fy, fz, tx, ty, tz), the contact force (fcx, fcy[, fcz]) and the gap; the column names
@@ -42,19 +57,39 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "alefsi/core/error.hpp"
+#include "alefsi/fem/element_pair.hpp"
 #include "alefsi/mesh/io/vtu.hpp"
 #include "alefsi/sim/newton.hpp"
+#include "alefsi/time/error_estimate.hpp"
+#include "alefsi/time/step_controller.hpp"
 
 namespace alefsi {
 
 struct RunOptions {
-  Real dt = 1e-3;                   ///< nominal time step (> 0)
+  Real dt = 1e-3;                   ///< the time step (fixed dt), or the first one (adaptive)
   Real t_end = 1;                   ///< > flow.time()
+  /// Adaptive steps: the tolerance on each step's local error estimate, relative to the flow's
+  /// velocity scale (time/error_estimate.hpp); 0: a fixed dt. Unset: `default_tolerance` for
+  /// the L-stable (BDF) schemes on a flow with FlowOptions::variable_steps, a fixed dt for
+  /// MR/AB or without variable steps. Set > 0, it needs both.
+  std::optional<Real> tolerance;
+  static constexpr Real default_tolerance = 1e-3;
+  /// Times that the steps land on exactly (adaptive: the step before one is shortened; fixed
+  /// dt: they are met when they are on the step grid), e.g. for samples or VTU output.
+  std::vector<Real> land_on;
+  Real velocity_scale = 0;          ///< adaptive: floor of the velocity scale (a small velocity; 0: none)
+  Real dt_max = 0;                  ///< adaptive: largest step (0: none)
+  Real dt_min = 0;                  ///< adaptive: a step below it stops the run (0: 1e-12 dt)
+  /// Adaptive: a free body travels at most this fraction of its gap (to the nearest body or
+  /// wall) in one step, so that collisions are approached in small steps; 0: no limit.
+  Real travel = 0.25;
   std::filesystem::path output;     ///< folder for CSV / VTU / checkpoints; empty: no files
   int vtu_every = 0;                ///< 0: no VTU
   int checkpoint_every = 0;         ///< 0: no checkpoints
@@ -75,11 +110,27 @@ struct RunOptions {
     ALEFSI_CHECK_ARG(max_retries >= 0, "max_retries", "must be >= 0, got ", max_retries);
     ALEFSI_CHECK_ARG(recover_after >= 1, "recover_after", "must be >= 1, got ", recover_after);
     ALEFSI_CHECK_ARG(absorb >= 0 && absorb < 1, "absorb", "must be in [0, 1), got ", absorb);
+    ALEFSI_CHECK_ARG(!tolerance || (*tolerance >= 0 && *tolerance < 1), "tolerance",
+                     "must be in [0, 1) (0: fixed dt), got ", tolerance.value_or(0));
+    for (Real t : land_on) ALEFSI_CHECK_ARG(std::isfinite(t), "land_on", "times must be finite, got ", t);
+    ALEFSI_CHECK_ARG(velocity_scale >= 0 && std::isfinite(velocity_scale), "velocity_scale", "must be >= 0, got ",
+                     velocity_scale);
+    ALEFSI_CHECK_ARG(dt_max >= 0 && std::isfinite(dt_max), "dt_max", "must be >= 0 (0: none), got ", dt_max);
+    ALEFSI_CHECK_ARG(dt_min >= 0 && std::isfinite(dt_min), "dt_min", "must be >= 0, got ", dt_min);
+    ALEFSI_CHECK_ARG(travel >= 0 && travel <= 1, "travel", "must be in [0, 1] (0: no limit), got ", travel);
+  }
+  /// The tolerance in effect for a flow of scheme S (0: fixed dt).
+  template <class S>
+  Real tolerance_for(bool variable_steps) const {
+    if (tolerance) return *tolerance;
+    return S::theta == 1 && variable_steps ? default_tolerance : 0;
   }
 };
 
 struct RunSummary {
   int steps = 0, rejected = 0, remeshes = 0;
+  int error_rejections = 0;  ///< adaptive: steps rejected by the error estimate (part of `rejected`)
+  Real dt_smallest = std::numeric_limits<Real>::infinity(), dt_largest = 0;  ///< accepted steps
   Real t = 0, wall_seconds = 0;
   Real worst_quality = 1;   ///< smallest worst-cell quality seen after any step
   Real min_gap = std::numeric_limits<Real>::infinity();  ///< smallest body gap seen (bodies or walls)
@@ -176,7 +227,7 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
     if (!csv) throw IoError("cannot open '" + csv_path.string() + "' for writing");
     csv << std::setprecision(17);
     if (!restart) {
-      csv << "t,dt,newton,remeshed,worst_quality";
+      csv << "t,dt,newton,remeshed,worst_quality,error";
       for (std::size_t k = 0; k < nb; ++k) detail::body_csv_header<typename Flow::BodyModel>(csv, k);
       csv << '\n';
     }
@@ -194,8 +245,39 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
   };
   if (pvd && t_start == 0) write_vtu_now();
 
-  Real dt = opt.dt;
+  // adaptive: the controller, continued from the flow's memory when the run is a continuation
+  using Scheme = typename Flow::Scheme;
+  const Real tolerance = opt.tolerance_for<Scheme>(flow.variable_steps());
+  const bool adaptive = tolerance > 0;
+  ALEFSI_CHECK_ARG(!adaptive || flow.variable_steps(), "tolerance",
+                   "adaptive steps need a flow with FlowOptions::variable_steps = true (or tolerance = 0: fixed dt)");
+  // The midpoint rule keeps the (-1)^n mode that every jump of dt excites (R(inf) = -1): with
+  // steps alternating 1.2 and 0.8 dt, MR/AB is first order (docs/theory.md, section 9), so a
+  // controller's step sequence would spoil it.
+  ALEFSI_CHECK_ARG(!adaptive || Scheme::theta == 1, "tolerance",
+                   Scheme::name, " is not L-stable: the step changes of adaptive runs leave an undamped oscillation "
+                   "that makes it first order; use a BDF scheme (BDF2/BDF2E, BDF2/AB, BDF3/BDF3E, BSS) or tolerance = 0");
+  constexpr bool stabilised = !std::is_same_v<typename Flow::Config::Pair::Stabilisation, NoStabilisation>;
+  ALEFSI_CHECK_ARG(!adaptive || !stabilised || flow.options().tau_dt > 0,
+                   "tolerance", "adaptive steps of a stabilised pair (", Flow::Config::Pair::name,
+                   ") need a fixed step in its tau (FlowOptions::tau_dt, e.g. the nominal dt): with each step's dt "
+                   "in tau the discrete problem changes with dt, which the error estimate cannot tell from a step "
+                   "error (or tolerance = 0: fixed dt)");
+  const ErrorControl control{tolerance, opt.velocity_scale};
+  PiStepController pi(Scheme::order, max_step_ratio<Scheme>(), adaptive ? flow.state().control.last_error : 0.0);
+  const Real dt_min = opt.dt_min > 0 ? opt.dt_min : 1e-12 * opt.dt;
+  Real dt = adaptive && flow.state().control.next_dt > 0 ? flow.state().control.next_dt : opt.dt;
   int good = 0;
+  // adaptive: no body travels more than `travel` of its gap in one step
+  auto travel_limit = [&](Real h) {
+    if (opt.travel <= 0) return h;
+    const std::vector<Real> gaps = flow.body_gaps();
+    for (std::size_t k = 0; k < nb; ++k) {
+      const Real speed = flow.body_velocity(k).template head<Flow::D>().norm();
+      if (speed > 0 && std::isfinite(gaps[k]) && gaps[k] > 0) h = std::min(h, opt.travel * gaps[k] / speed);
+    }
+    return h;
+  };
   auto log = [&](const std::string& text) {
     if (opt.log) *opt.log << text << std::endl;
   };
@@ -205,11 +287,27 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
   auto left = [&] { return opt.t_end - flow.time(); };
   while (left() > 1e-9 * opt.dt) {
     Real h = dt;
-    if (std::abs(left() - dt) > 1e-9 * dt && left() < (1 + opt.absorb) * dt) h = left();
+    if (adaptive) {
+      if (opt.dt_max > 0) h = std::min(h, opt.dt_max);
+      h = travel_limit(h);
+      // the next time to land on: t_end or the first of land_on after t
+      Real to_go = left();
+      for (Real t_land : opt.land_on)
+        if (t_land - flow.time() > 1e-9 * h) to_go = std::min(to_go, t_land - flow.time());
+      if (to_go < (1 + opt.absorb) * h) h = to_go;  // land on it
+      else if (to_go < 2 * h) h = to_go / 2;      // in two equal steps rather than with a sliver
+    } else if (std::abs(left() - dt) > 1e-9 * dt && left() < (1 + opt.absorb) * dt) {
+      h = left();
+    }
     decltype(flow.step(Real(1))) rep{};
-    int tries = 0;
+    int tries = 0, error_tries = 0;
     Real h_try = h;
     for (;;) {
+      if (adaptive && h_try < dt_min) {
+        if (checkpoints) flow.save_checkpoint(checkpoint);
+        throw Error("step at t = " + detail::sci(flow.time()) + ": the step size " + detail::sci(h_try) +
+                    " fell below dt_min = " + detail::sci(dt_min));
+      }
       auto reject = [&](const Error& e) {
         if (++tries > opt.max_retries) {
           if (checkpoints) flow.save_checkpoint(checkpoint);  // the last good state
@@ -219,8 +317,12 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
         log("  rejected step at t = " + detail::sci(flow.time()) + " (dt " + detail::sci(h_try) + "): " + e.what());
       };
       try {
-        rep = flow.step(h_try);
+        rep = flow.step(h_try, control);
         break;
+      } catch (const StepRejected& e) {  // the error estimate exceeds the tolerance
+        ++sum.rejected, ++sum.error_rejections, ++error_tries;
+        h_try = pi.rejected(h_try, e.scaled_error());
+        continue;
       } catch (const SolverError& e) {  // Newton failed, non-finite values, an overlap
         reject(e);
       } catch (const MeshError& e) {  // a cell would invert
@@ -231,8 +333,16 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
       dt = h_try;
       good = 0;
     }
-    if (dt < opt.dt && ++good >= opt.recover_after) dt = std::min(opt.dt, 2 * dt), good = 0;
+    const Real err = rep.error.scaled(control);
+    if (adaptive) {
+      dt = pi.accepted(h_try, rep.error.available, err, tries + error_tries > 0);
+      if (rep.remeshed) dt = std::min(dt, h_try);  // the transferred levels: no growth across a remesh
+      flow.set_step_control(dt, pi.last_error());
+    } else if (dt < opt.dt && ++good >= opt.recover_after) {
+      dt = std::min(opt.dt, 2 * dt), good = 0;
+    }
     ++sum.steps;
+    sum.dt_smallest = std::min(sum.dt_smallest, h_try), sum.dt_largest = std::max(sum.dt_largest, h_try);
     sum.t_mesh_velocity += rep.t_mesh_velocity, sum.t_assembly += rep.t_assembly;
     sum.t_factorize += rep.t_factorize, sum.t_solve += rep.t_solve, sum.t_remesh += rep.t_remesh;
     const Real q = flow.worst_quality();
@@ -242,7 +352,8 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
     for (Real g : gaps) gap_min = std::min(gap_min, g);
     sum.min_gap = std::min(sum.min_gap, gap_min);
     if (csv.is_open()) {
-      csv << flow.time() << ',' << h_try << ',' << rep.newton_iterations << ',' << int(rep.remeshed) << ',' << q;
+      csv << flow.time() << ',' << h_try << ',' << rep.newton_iterations << ',' << int(rep.remeshed) << ',' << q << ','
+          << err;
       for (std::size_t k = 0; k < nb; ++k) detail::body_csv_row(csv, flow, k, gaps[k]);
       csv << '\n' << std::flush;
     }

@@ -5,7 +5,8 @@
 /// the bodies' descriptions are rebuilt from the scene's configuration).
 ///
 ///   time      the step-size history (time/history.hpp): t^n, the last step sizes, the levels
-///   X[k]      node positions at t^{n-k} (X[0] is the mesh's; X[1], X[2] empty until taken)
+///   X[k]      node positions at t^{n-k}, k = 0..3 (X[0] is the mesh's; the others empty until
+///             taken)
 ///   U[k]      field vectors at t^{n-k} (MixedSpace layout: velocity interleaved, then pressure;
 ///             the pressure at the scheme's level n - 1 + theta)
 ///   V         mesh velocity at t^n (per node)
@@ -15,6 +16,8 @@
 ///   stats     steps taken, remeshes, history restarts (and the last step's active contacts,
 ///             not written)
 ///   remesh    what the remesh trigger remembers of the last remesh
+///   control   what the step-size controller remembers (the next dt, the last error, the steps
+///             since the last remesh)
 ///
 /// `write_state` / `read_state` put it in / take it from a checkpoint (sim/checkpoint.hpp);
 /// `backfill`, `richardson` and `start_history` are the state algebra of the start-up
@@ -33,7 +36,7 @@
 
 namespace alefsi {
 
-/// One rigid body's part of the flow state (levels n, n-1, n-2).
+/// One rigid body's part of the flow state (levels n ... n-3).
 template <int D, RigidBodyModel M>
 struct BodyState {
   using Velocity = typename M::Velocity;
@@ -44,6 +47,17 @@ struct BodyState {
   Velocity load = Velocity::Zero();  ///< hydrodynamic force and torque over the last step
   Vec<D> contact = Vec<D>::Zero();   ///< contact force in the last step
   std::vector<Vec<D>> surface;       ///< surface node offsets from the centre, model frame
+};
+
+/// What an adaptive time loop (sim/driver.hpp) remembers between steps, kept with the state so
+/// that a run continued from a checkpoint takes the steps the uninterrupted run takes.
+struct StepControlMemory {
+  Real next_dt = 0;     ///< the step the controller chose for the next step (0: none yet)
+  Real last_error = 0;  ///< the last accepted step's scaled error estimate (0: none)
+  /// Steps since the last remesh (-1: none yet). The levels before it were interpolated onto
+  /// the new mesh: a step whose predictor reads one of them has no error estimate (what the
+  /// remesh changed is a spatial error, not the step's).
+  int steps_since_remesh = -1;
 };
 
 /// What the flow did so far (for logs).
@@ -61,6 +75,7 @@ struct FlowState {
   std::vector<BodyState<D, M>> bodies;
   FlowStats stats;
   RemeshMemory remesh;
+  StepControlMemory control;
 };
 
 /// The first step after a (re)start of a scheme that reads level n-1: X^{n-1} = X^n - dt V^n,
@@ -96,13 +111,13 @@ void richardson(FlowState<D, M>& coarse, const FlowState<D, M>& fine) {
 }
 
 /// After a start-up procedure took `s` from `s0` (at t^n) to t^n + dt by other means (substeps):
-/// the history is t^n + dt with one past level, s0's level 0 (level 2 is not read with one
-/// level; it holds the same).
+/// the history is t^n + dt with one past level, s0's level 0 (the older levels are not read
+/// with one level; they hold the same).
 template <int D, RigidBodyModel M>
 void start_history(FlowState<D, M>& s, const FlowState<D, M>& s0, Real dt) {
-  for (int k = 1; k < 3; ++k) s.X[k] = s0.X[0], s.U[k] = s0.U[0];
+  for (int k = 1; k < s.X.size(); ++k) s.X[k] = s0.X[0], s.U[k] = s0.U[0];
   for (std::size_t i = 0; i < s.bodies.size(); ++i)
-    for (int k = 1; k < 3; ++k) {
+    for (int k = 1; k < s.X.size(); ++k) {
       s.bodies[i].centre[k] = s0.bodies[i].centre[0];
       s.bodies[i].orientation[k] = s0.bodies[i].orientation[0];
       s.bodies[i].velocity[k] = s0.bodies[i].velocity[0];
@@ -157,6 +172,9 @@ void write_state(CheckpointWriter& w, const FlowState<D, M>& s, const std::vecto
   w.put(std::int32_t(s.stats.history_restarts));
   w.put(s.remesh.quality);
   w.put(s.remesh.deviation);
+  w.put(s.control.next_dt);
+  w.put(s.control.last_error);
+  w.put(std::int32_t(s.control.steps_since_remesh));
   for (int k = 1; k < s.X.size(); ++k) w.put_vector(detail::flatten(s.X[k]));
   for (int k = 0; k < s.U.size(); ++k) w.put_vector(s.U[k]);
   w.put_vector(detail::flatten(s.V));
@@ -199,6 +217,11 @@ void read_state(CheckpointReader& r, FlowState<D, M>& s, const std::vector<int>&
   s.stats.history_restarts = r.get<std::int32_t>("history restarts");
   s.remesh.quality = r.get<Real>("remesh state");
   s.remesh.deviation = r.get<Real>("remesh state");
+  s.control.next_dt = r.get<Real>("step control");
+  s.control.last_error = r.get<Real>("step control");
+  s.control.steps_since_remesh = r.get<std::int32_t>("step control");
+  if (!(s.control.next_dt >= 0) || !(s.control.last_error >= 0) || s.control.steps_since_remesh < -1)
+    r.fail("invalid step-control state");
   for (int k = 1; k < s.X.size(); ++k) s.X[k] = detail::unflatten<D>(r.get_vector<Real>("positions"));
   for (int k = 0; k < s.U.size(); ++k) s.U[k] = r.get_vecx("field");
   s.V = detail::unflatten<D>(r.get_vector<Real>("mesh velocity"));

@@ -86,9 +86,10 @@ class TimeHistory {
   std::int64_t run_count_ = 0;
 };
 
-/// The levels n, n-1, n-2 of a quantity (positions, a field, a body's velocity): `at[k]` is
-/// level n-k. `push` shifts them back and makes `x` level n.
-template <class T, int N = TimeHistory::depth>
+/// The levels n, n-1, n-2, n-3 of a quantity (positions, a field, a body's velocity): `at[k]`
+/// is level n-k (the three-level schemes read n ... n-2; the error estimate of BDF3 reads n-3,
+/// time/error_estimate.hpp). `push` shifts them back and makes `x` level n.
+template <class T, int N = TimeHistory::depth + 1>
 struct Levels {
   std::array<T, N> at{};
 

@@ -87,6 +87,56 @@ using SpdSolvers = std::tuple<SimplicialLlt>;
 
 }  // namespace
 
+TEST_CASE("factorisation reuse: GMRES on an earlier matrix's factors solves later matrices to its tolerance, and "
+          "refactorises when they drift too far",
+          "[la][solvers][reuse][quick]") {
+  const LinearSystem s = stokes_system<TaylorHood>(8);
+  // later matrices: the velocity block plus a mass-like diagonal term that grows (as 1/dt
+  // changes from step to step), the pattern unchanged
+  const Index nu = s.A.rows() - 81 + 1;  // the pressure unknowns (81 minus the pinned one) come last
+  auto drifted = [&](Real eps) {
+    SparseMatrix A = s.A;
+    for (Index k = 0; k < nu; ++k) A.coeffRef(k, k) *= 1 + eps;
+    return A;
+  };
+  LinearSolve<SparseLu<>> lin;
+  lin.set_reuse({.enabled = true, .max_iterations = 16, .refactor_above = 8, .tolerance = 1e-13});
+  LinearSolveCounts counts;
+  SparseMatrix A0 = drifted(0);
+  lin.factorize(A0);
+  ++counts.factorisations;
+  CHECK(relative_residual(A0, lin.solve(A0, s.b, counts), s.b) < 1e-13);  // the fresh factors: direct
+  CHECK(counts.reused == 0);
+  for (Real eps : {0.001, 0.002}) {
+    const SparseMatrix A = drifted(eps);
+    REQUIRE(lin.reusable());
+    const VecX x = lin.solve(A, s.b, counts);
+    CHECK(relative_residual(A, x, s.b) < 1e-12);
+    CHECK((x - solve_with<SparseLu<>>(A, s.b)).norm() < 1e-10 * x.norm());
+  }
+  CHECK(counts.factorisations == 1);
+  CHECK(counts.reused == 2);
+  CHECK(counts.krylov_iterations <= 2 * 8);
+  // far from the factorised matrix: GMRES misses in 16 iterations and the matrix is factorised
+  const SparseMatrix far = drifted(3.0);
+  const VecX x = lin.solve(far, s.b, counts);
+  CHECK(relative_residual(far, x, s.b) < 1e-12);
+  CHECK(counts.factorisations == 2);
+  // an iterative solver never reuses
+  LinearSolve<BiCgStabIlut> iterative;
+  iterative.set_reuse({.enabled = true});
+  CHECK(!iterative.reuse().enabled);
+  // a checkpoint's restore gives the same factors: the next reused solve is the same, bit for bit
+  LinearSolve<SparseLu<>> again;
+  again.set_reuse(lin.reuse());
+  SparseMatrix pattern = s.A;
+  again.restore(pattern, lin.analysed_values(), lin.factored_values(), lin.refactor_next());
+  const SparseMatrix next = drifted(3.02);
+  LinearSolveCounts c1, c2;
+  CHECK(lin.solve(next, s.b, c1) == again.solve(next, s.b, c2));
+  CHECK(c1.krylov_iterations == c2.krylov_iterations);
+}
+
 TEST_CASE("Eigen's AMDOrdering convention; the SparseLU orderings are the right way round", "[la][solvers][quick]") {
   // arrowhead: unknown 0 is coupled to every other one, so AMD eliminates it last
   const Index n = 6;

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Seeds for fuzz_checkpoint from a real checkpoint (format version 3).
+"""Seeds for fuzz_checkpoint from a real checkpoint (format version 4).
 
 usage: make_checkpoint_seeds.py CHECKPOINT OUTDIR
 Writes OUTDIR/raw_<name> (mode byte 0, then the file) and OUTDIR/framed_<name> (mode byte 1,

@@ -258,6 +258,24 @@ TEST_CASE("CollisionContact2D: eq. (24) + spring through the seam, momentum bala
   const auto g = model.gaps(b);
   CHECK(g[0] == Approx(0.3 - R).epsilon(1e-12));          // the bottom wall
   CHECK(g[1] == Approx(2 - 1.5 - R).epsilon(1e-12));      // the top wall
+  // times to contact: gap / closing speed, over what each body approaches
+  b[0].velocity = Vec<2>(0, -2);                          // falls toward the floor
+  b[1].velocity = Vec<2>(0.5, -3);                        // chases it, and drifts right
+  auto tc = model.times_to_contact(b);
+  const Real between = 1.5 - 0.3 - 2 * R;                 // closing at 1 (3 - 2)
+  CHECK(tc[0] == Approx((0.3 - R) / 2).epsilon(1e-12));  // the floor first
+  CHECK(between / 1.0 < (2 - 1 - R) / 0.5);              // the other disk before the right wall,
+  CHECK(tc[1] == Approx((1.5 - R) / 3).epsilon(1e-12));  // but the floor (not the nearest wall) first
+  b[0].velocity = Vec<2>::Zero(), b[1].velocity = Vec<2>(0, -1);
+  tc = model.times_to_contact(b);
+  CHECK(tc[1] == Approx(between / 1.0).epsilon(1e-12));  // now the disk first, for both
+  CHECK(tc[0] == tc[1]);
+  b[0].velocity = Vec<2>(0, -2);  // the lower one falls faster: the floor for the upper one
+  CHECK(model.times_to_contact(b)[1] == Approx((1.5 - R) / 1.0).epsilon(1e-12));
+  // toward the right wall, mid-height (closest points on the other walls approach more slowly)
+  CHECK(model.times_to_contact({disk_at({1, 1}, R, Vec<2>(0.5, 0))})[0] == Approx((2 - 1 - R) / 0.5).epsilon(1e-12));
+  b[0].velocity = b[1].velocity = Vec<2>::Zero();
+  CHECK(model.times_to_contact(b)[0] == std::numeric_limits<Real>::infinity());
   // geometry only: no forces
   CollisionContact2D geometry;
   geometry.set_walls(box, {});

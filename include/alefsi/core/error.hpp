@@ -9,6 +9,7 @@
 ///     try { auto m = alefsi::read_gmsh<2>("box.msh"); }
 ///     catch (const alefsi::ParseError& e) { std::cerr << e.file() << ':' << e.line(); }
 #include <cstddef>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -95,6 +96,12 @@ std::string concat(const Args&... args) {
   std::ostringstream os;
   (os << ... << args);
   return os.str();
+}
+/// x in scientific notation with four significant digits ("1.234e-05"), for messages.
+inline std::string sci(Real x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3e", x);
+  return buf;
 }
 }  // namespace detail
 

@@ -54,6 +54,7 @@
 #include "alefsi/fem/dofmap.hpp"
 #include "alefsi/fem/quadrature.hpp"
 #include "alefsi/la/amg.hpp"
+#include "alefsi/la/gmres.hpp"
 #include "alefsi/la/saddle_point_blocks.hpp"
 #include "alefsi/la/solvers.hpp"
 
@@ -207,64 +208,21 @@ class SaddlePointGmres {
         schur_inv_diag_ = sd.cwiseInverse();
       }
     }
-    V_.resize(0, 0);
+    work_.V.resize(0, 0);
   }
 
   VecX solve(const VecX& b) {
     if (!A_) throw SolverError(std::string(name) + ": solve before factorize");
     ALEFSI_CHECK_ARG(b.size() == n_, "b", "has ", b.size(), " entries, expected ", n_);
-    const SparseMatrix& A = *A_;
-    const int m = opt_.restart;
-    VecX x = VecX::Zero(n_);
-    iterations_ = 0;
-    const Real bnorm = b.norm();
-    residual_ = 0;
-    if (bnorm == 0) return x;
-    const Real target = opt_.tolerance * bnorm;
-    if (V_.cols() != m + 1 || V_.rows() != n_) V_.resize(n_, m + 1);
-    MatX H = MatX::Zero(m + 1, m);
-    VecX g(m + 1), cs(m), sn(m), w(n_);
-    VecX r = b;
-    Real rnorm = r.norm();
-    while (rnorm > target) {
-      if (iterations_ >= opt_.max_iterations)
-        throw SolverError(std::string(name) + " did not converge: " + std::to_string(iterations_) +
-                          " iterations, relative residual " + std::to_string(rnorm / bnorm));
-      V_.col(0) = r / rnorm;
-      g.setZero();
-      g[0] = rnorm;
-      H.setZero();
-      int k = 0;
-      while (k < m && iterations_ < opt_.max_iterations) {
-        w.noalias() = A * precondition(V_.col(k));
-        for (int i = 0; i <= k; ++i) {  // modified Gram–Schmidt
-          H(i, k) = w.dot(V_.col(i));
-          w.noalias() -= H(i, k) * V_.col(i);
-        }
-        H(k + 1, k) = w.norm();
-        if (H(k + 1, k) > 0) V_.col(k + 1) = w / H(k + 1, k);
-        for (int i = 0; i < k; ++i) {  // earlier rotations
-          const Real t = cs[i] * H(i, k) + sn[i] * H(i + 1, k);
-          H(i + 1, k) = -sn[i] * H(i, k) + cs[i] * H(i + 1, k);
-          H(i, k) = t;
-        }
-        const Real h = std::hypot(H(k, k), H(k + 1, k));
-        cs[k] = H(k, k) / h;
-        sn[k] = H(k + 1, k) / h;
-        H(k, k) = h;
-        H(k + 1, k) = 0;
-        g[k + 1] = -sn[k] * g[k];
-        g[k] = cs[k] * g[k];
-        ++k;
-        ++iterations_;
-        if (std::abs(g[k]) <= target) break;
-      }
-      const VecX y = H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
-      x.noalias() += precondition(V_.leftCols(k) * y);
-      r.noalias() = b - A * x;
-      rnorm = r.norm();
-    }
-    residual_ = rnorm / bnorm;
+    VecX x;
+    const GmresResult res = gmres(
+        *A_, b, [this](const VecX& v) { return precondition(v); },
+        {.tolerance = opt_.tolerance, .max_iterations = opt_.max_iterations, .restart = opt_.restart}, x, work_);
+    iterations_ = res.iterations, residual_ = res.residual;
+    if (!res.converged)
+      throw SolverError(std::string(name) + " did not converge: " + std::to_string(res.iterations) +
+                        " iterations, relative residual " + detail::sci(res.residual) + " (tolerance " +
+                        detail::sci(opt_.tolerance) + ")");
     return x;
   }
 
@@ -345,7 +303,7 @@ class SaddlePointGmres {
   Eigen::PartialPivLU<MatX> body_lu_;
   VecX schur_inv_diag_, mass_inv_diag_;
   Real cheb_lo_ = 0.5, cheb_hi_ = 2.5, mass_scale_ = 1;
-  MatX V_;
+  GmresWork work_;
   int iterations_ = 0;
   Real residual_ = 0;
 };

@@ -52,6 +52,11 @@ concept LinearSolver = requires(S s, const SparseMatrix& A, const VecX& b) {
   { S::name } -> std::convertible_to<const char*>;
 };
 
+/// A solver whose factors solve its matrix exactly (to rounding), marked by `direct = true`,
+/// so that they can precondition later matrices (factorisation reuse, sim/newton.hpp).
+template <class S>
+concept DirectSolver = LinearSolver<S> && requires { requires S::direct; };
+
 namespace detail {
 /// How SparseLu uses an ordering: the functor SparseLU calls, whether the ordering is
 /// symmetric (then SparseLU runs in symmetric mode with diagonal pivoting) and its name.
@@ -98,6 +103,7 @@ class SparseLu {
 
  public:
   static constexpr const char* name = "SparseLU";
+  static constexpr bool direct = true;
   static constexpr const char* ordering_name = Traits::name;
   static constexpr bool symmetric_mode = Traits::symmetric;
   /// Default diagonal pivot threshold: a diagonal pivot is kept unless it is smaller than
@@ -169,6 +175,7 @@ class BiCgStabIlut {
 class SimplicialLlt {
  public:
   static constexpr const char* name = "SimplicialLLT";
+  static constexpr bool direct = true;
   void analyze(const SparseMatrix& A) {
     llt_.analyzePattern(A);
     analyzed_ = true;

@@ -67,6 +67,7 @@ struct UmfPackLuWithInfo : Eigen::UmfPackLU<SparseMatrix> {
 class UmfPackLu {
  public:
   static constexpr const char* name = "UMFPACK";
+  static constexpr bool direct = true;
   enum class Strategy { automatic, symmetric, unsymmetric };
 
   explicit UmfPackLu(Strategy strategy = Strategy::symmetric) : lu_(std::make_unique<detail::UmfPackLuWithInfo>()) {
@@ -109,6 +110,7 @@ class UmfPackLu {
 class CholmodLlt {
  public:
   static constexpr const char* name = "CHOLMOD";
+  static constexpr bool direct = true;
   CholmodLlt() : llt_(std::make_unique<Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower>>()) {
     llt_->setMode(Eigen::CholmodSupernodalLLt);
   }

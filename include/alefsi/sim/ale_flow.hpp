@@ -71,12 +71,17 @@ struct StepReport {
   /// iterations), numeric factorisation (incl. the one-off symbolic analysis), triangular
   /// solves, adaptation + transfer + rebuild.
   Real t_mesh_velocity = 0, t_assembly = 0, t_factorize = 0, t_solve = 0, t_remesh = 0;
+  /// The flow system's linear solves: factorisations, solves reusing an earlier factorisation
+  /// (FlowOptions::reuse_factorisation) and their GMRES iterations.
+  LinearSolveCounts linear;
 
   void add(const StepReport& r) {
     newton_iterations += r.newton_iterations;
     residuals.insert(residuals.end(), r.residuals.begin(), r.residuals.end());
     t_mesh_velocity += r.t_mesh_velocity, t_assembly += r.t_assembly, t_factorize += r.t_factorize;
     t_solve += r.t_solve, t_remesh += r.t_remesh;
+    linear.factorisations += r.linear.factorisations, linear.reused += r.linear.reused;
+    linear.krylov_iterations += r.linear.krylov_iterations;
   }
 };
 
@@ -212,6 +217,10 @@ class AleFlow {
   Vec<D> body_collision_force(std::size_t k) const { return state_.bodies.at(k).contact; }
   /// Per body, the gap to the nearest other body or wall at t^n (the contact model's).
   std::vector<Real> body_gaps() const { return contact_->gaps(bodies_.contact_bodies(state_.bodies, 0)); }
+  /// Per body, the smallest gap / closing speed to a body or wall it approaches (infinity: none).
+  std::vector<Real> body_times_to_contact() const {
+    return contact_->times_to_contact(bodies_.contact_bodies(state_.bodies, 0));
+  }
 
   // ---- stepping ------------------------------------------------------------------------------
   /// Checks the scene and builds what the first step needs (constraints, contact walls). A
@@ -277,6 +286,12 @@ class AleFlow {
     write_config(w);
     write_mesh(w, mesh_);
     write_state(w, state_, bodies_.tags());
+    // the factorisation a reused solve would precondition with (empty: none)
+    const auto& lin = disc_.linear_solve();
+    w.section("solver");
+    w.put_vector(lin.analysed_values());
+    w.put_vector(lin.factored_values());
+    w.put(std::int32_t(lin.refactor_next()));
     w.commit(true);
   }
   /// Restores what `save_checkpoint` wrote into a flow that has not stepped yet and was built
@@ -292,10 +307,24 @@ class AleFlow {
       r.fail("the flow's mesh is not the checkpoint's (build it with read_checkpoint_mesh)");
     State s = state_;
     read_state(r, s, bodies_.tags(), space().n_field());
+    r.section("solver");
+    const auto analysed = r.get_vector<Real>("analysed matrix");
+    const auto factored = r.get_vector<Real>("factorised matrix");
+    const bool refactor_next = r.get<std::int32_t>("refactorisation flag") != 0;
+    if (analysed.size() != factored.size()) r.fail("the kept matrices differ in size");
     r.finish();
     s.X[0] = mesh_.coordinates();
     state_ = std::move(s);
     setup();
+    if (!factored.empty()) {
+      SparseMatrix& J = disc_.jacobian();
+      disc_.assembler().take_pattern(J);
+      if (std::size_t(J.nonZeros()) != factored.size())
+        throw IoError("checkpoint '" + file.string() + "': the kept matrices have " + std::to_string(factored.size()) +
+                      " entries, the flow's pattern " + std::to_string(J.nonZeros()));
+      disc_.linear_solve().restore(J, Eigen::Map<const VecX>(analysed.data(), Index(analysed.size())),
+                                   Eigen::Map<const VecX>(factored.data(), Index(factored.size())), refactor_next);
+    }
   }
 
  private:
@@ -404,13 +433,17 @@ class AleFlow {
       if (s.U[k].size() != field.size()) return est;  // a level not taken yet
     est.available = true;
     const auto& vel = space().velocity();
+    const DofConstraints& cons = disc_.constraints();
     for (Index i = 0; i < vel.n_dofs(); ++i)
       for (int d = 0; d < D; ++d) {
         const Index j = space().velocity_field(i, d);
+        est.scale = std::max(est.scale, std::abs(field[j]));
+        // the free DOFs only: prescribed values (a wall's data) and a body's surface (its Z,
+        // estimated below) are not the scheme's error
+        if (cons.kind(j) != DofConstraints::Kind::free) continue;
         Real p = 0;
         for (int k = 0; k < w.points; ++k) p += w.predictor[std::size_t(k)] * s.U[k][j];
         est.velocity = std::max(est.velocity, std::abs(w.constant * (field[j] - p)));
-        est.scale = std::max(est.scale, std::abs(field[j]));
       }
     for (std::size_t b = 0; b < s.bodies.size(); ++b) {
       if (!bodies_.is_free(b)) continue;
@@ -467,6 +500,7 @@ class AleFlow {
     const NewtonReport nr = newton_solve(residual, disc_.linear_solve(), disc_.jacobian(), u, no);
     rep.newton_iterations = nr.iterations, rep.residuals = nr.residuals;
     rep.t_assembly = nr.t_assembly, rep.t_factorize = nr.t_factorize, rep.t_solve = nr.t_solve;
+    rep.linear = nr.linear;
     return u;
   }
 

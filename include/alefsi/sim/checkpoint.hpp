@@ -43,7 +43,8 @@ namespace alefsi {
 inline constexpr char checkpoint_magic[9] = "ALEFSICK";
 /// 2: the step-size history replaces the last dt; 3: section lengths and checksums, the
 /// configuration section, the time counter; 4: four solution levels (the error estimate of
-/// BDF3 reads n-3), the step-size controller's memory.
+/// BDF3 reads n-3), the step-size controller's memory, the "solver" section (the matrices whose
+/// analysis and factorisation a reused solve preconditions with).
 inline constexpr std::uint32_t checkpoint_version = 4;
 
 namespace detail {

@@ -116,6 +116,13 @@ struct FlowOptions {
   /// step error; adaptive runs (RunOptions::tolerance) of a stabilised pair need a fixed value
   /// here, e.g. the nominal step (run() refuses them otherwise). Ignored by stable pairs.
   Real tau_dt = 0;
+  /// Factorisation reuse (direct solvers; sim/newton.hpp, FactorisationReuse): a step's linear
+  /// solve is GMRES preconditioned by the factors of an earlier matrix, to a relative residual
+  /// of 1e-13, and the matrix is factorised afresh when that takes more than 16 iterations (the
+  /// next one when it took more than 8) and after every remesh. The choice is automatic;
+  /// false: every solve factorises (the results differ at the 1e-13 level). Checkpoints keep the
+  /// factorised matrix, so a continued run is bit for bit the uninterrupted one either way.
+  bool reuse_factorisation = true;
 
   void validate() const {
     ALEFSI_CHECK_ARG(rho >= 0 && std::isfinite(rho), "rho", "fluid density must be >= 0 and finite, got ", rho);

@@ -8,7 +8,8 @@
 ///     facet whose tag is not a body's);
 ///   - `overlaps(bodies)`: pairs of bodies whose surfaces overlap — a scene is refused at t0
 ///     and a step is rejected (SolverError) when the positions it would give overlap;
-///   - `gaps(bodies)`: per body, the smallest distance to another body or a wall (run()'s CSV);
+///   - `gaps(bodies)`: per body, the smallest distance to another body or a wall (run()'s CSV),
+///     and `times_to_contact(bodies)`: gap over closing speed (the adaptive driver's event);
 ///   - `find(bodies, mu)` then `forces(velocities, visit)`: the contacts of the step being
 ///     solved, from the bodies placed at t^{n+1}, and their forces at the velocities of the
 ///     current Newton iterate. For each contact, `visit(body, F, dF)` is called on each free or
@@ -64,6 +65,12 @@ class ContactModel {
   virtual std::vector<ContactOverlap> overlaps(const std::vector<ContactBody<D>>& bodies) const = 0;
   /// Per body, the smallest gap to another body or a wall (infinity if none is known).
   virtual std::vector<Real> gaps(const std::vector<ContactBody<D>>& bodies) const = 0;
+  /// Per body, the smallest time to contact, gap / closing speed, over the bodies and walls it
+  /// approaches (infinity if none): the collision event of adaptive runs (sim/driver.hpp). The
+  /// default knows no distances.
+  virtual std::vector<Real> times_to_contact(const std::vector<ContactBody<D>>& bodies) const {
+    return std::vector<Real>(bodies.size(), std::numeric_limits<Real>::infinity());
+  }
   /// Finds the contacts of the step (bodies at t^{n+1}) for viscosity mu; returns their number.
   virtual int find(const std::vector<ContactBody<D>>& bodies, Real mu) = 0;
   /// Visits the forces of the contacts found, at the bodies' translational velocities `v`.

@@ -59,6 +59,33 @@ class CollisionContact2D final : public ContactModel<2> {
     return g;
   }
 
+  std::vector<Real> times_to_contact(const std::vector<ContactBody<2>>& bodies) const override {
+    std::vector<Real> t(bodies.size(), std::numeric_limits<Real>::infinity());
+    auto take = [&](std::size_t k, Real gap, Real closing) {
+      if (closing > 0) t[k] = std::min(t[k], std::max(gap, Real(0)) / closing);
+    };
+    // bodies: the normal points from j to k, the gap closes at -(V_k - V_j) . n
+    CollisionModel2D model(CollisionOptions{.range = 1e6, .walls = false});
+    for (const auto& c : model.contacts(convert(bodies), 1.0))
+      if (c.j >= 0) {
+        const std::size_t k = std::size_t(c.k), j = std::size_t(c.j);
+        take(k, c.gap, -(bodies[k].velocity - bodies[j].velocity).dot(c.normal));
+        t[j] = std::min(t[j], t[k]);
+      }
+    // every wall segment, not only the nearest (a disk sliding along a side wall still falls
+    // toward the floor); a body without radius by its outer radius
+    const auto& walls = model_ ? model_->walls() : walls_;
+    for (std::size_t k = 0; k < bodies.size(); ++k) {
+      const Real r = bodies[k].radius > 0 ? bodies[k].radius : bodies[k].r_out;
+      for (const auto& w : walls) {
+        const Vec<2> d = bodies[k].centre - detail::closest_on_segment(bodies[k].centre, w);
+        const Real dist = d.norm();
+        if (dist > 0) take(k, dist - r, -bodies[k].velocity.dot(d / dist));
+      }
+    }
+    return t;
+  }
+
   int find(const std::vector<ContactBody<2>>& bodies, Real mu) override {
     contacts_.clear();
     bodies_.clear();

@@ -55,6 +55,7 @@ class Discretisation {
   template <class... SolverArgs>
   Discretisation(const Mesh<D>& mesh, const FlowOptions& opt, SolverArgs&&... solver_args)
       : opt_(opt), solve_(std::forward<SolverArgs>(solver_args)...) {
+    solve_.set_reuse({.enabled = opt_.reuse_factorisation});
     rebuild(mesh);
   }
   Discretisation(const Discretisation&) = delete;  // the parts point into each other
@@ -130,6 +131,7 @@ class Discretisation {
   const FlowAssembler& assembler() const { return *asmb_; }
   SparseMatrix& jacobian() { return J_; }
   LinearSolve<Solver>& linear_solve() { return solve_; }
+  const LinearSolve<Solver>& linear_solve() const { return solve_; }
   /// (scalar velocity DOF, tag) of the Dirichlet DOFs.
   const std::vector<std::pair<Index, int>>& dirichlet_dofs() const { return dirichlet_dofs_; }
   /// Pressure DOF 0 is pinned (the pressure is shifted to zero mean after each solve).

@@ -10,9 +10,9 @@
 ///    is checked by its local error estimate (time/error_estimate.hpp) against `tolerance`
 ///    times the flow's velocity scale; a step above it is rejected (StepRejected, the flow stays
 ///    at t^n) and retried smaller; the next step comes from Söderlind's PI controller
-///    (time/step_controller.hpp), within the scheme's step-ratio bound. Events shrink it: a free
-///    body travels at most `travel` of its gap (to a body or a wall) per step, so collisions are
-///    approached in small steps; a step after a remesh does not grow; `dt_max` caps it. Steps
+///    (time/step_controller.hpp), within the scheme's step-ratio bound. Events shrink it: no gap
+///    between a body and what it approaches (a body, a wall) closes by more than `travel` of
+///    itself per step, so collisions are approached in small steps; a step after a remesh does not grow; `dt_max` caps it. Steps
 ///    land exactly on `land_on` times and on t_end (the step before is shortened, or the rest
 ///    split in two when shortening would leave a sliver). The controller's memory (next dt,
 ///    last error) is part of the flow's state, so a run continued from a checkpoint is bit for
@@ -87,8 +87,9 @@ struct RunOptions {
   Real velocity_scale = 0;          ///< adaptive: floor of the velocity scale (a small velocity; 0: none)
   Real dt_max = 0;                  ///< adaptive: largest step (0: none)
   Real dt_min = 0;                  ///< adaptive: a step below it stops the run (0: 1e-12 dt)
-  /// Adaptive: a free body travels at most this fraction of its gap (to the nearest body or
-  /// wall) in one step, so that collisions are approached in small steps; 0: no limit.
+  /// Adaptive: no gap between a body and a body or wall it approaches closes by more than this
+  /// fraction of itself in one step (at the current closing speed), so that collisions are
+  /// approached in small steps; 0: no limit.
   Real travel = 0.25;
   std::filesystem::path output;     ///< folder for CSV / VTU / checkpoints; empty: no files
   int vtu_every = 0;                ///< 0: no VTU
@@ -131,6 +132,8 @@ struct RunSummary {
   int steps = 0, rejected = 0, remeshes = 0;
   int error_rejections = 0;  ///< adaptive: steps rejected by the error estimate (part of `rejected`)
   Real dt_smallest = std::numeric_limits<Real>::infinity(), dt_largest = 0;  ///< accepted steps
+  /// The accepted steps' linear solves: factorisations, solves that reused one, GMRES iterations
+  LinearSolveCounts linear;
   Real t = 0, wall_seconds = 0;
   Real worst_quality = 1;   ///< smallest worst-cell quality seen after any step
   Real min_gap = std::numeric_limits<Real>::infinity();  ///< smallest body gap seen (bodies or walls)
@@ -268,14 +271,11 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
   const Real dt_min = opt.dt_min > 0 ? opt.dt_min : 1e-12 * opt.dt;
   Real dt = adaptive && flow.state().control.next_dt > 0 ? flow.state().control.next_dt : opt.dt;
   int good = 0;
-  // adaptive: no body travels more than `travel` of its gap in one step
+  // adaptive: no gap closes by more than `travel` of itself in one step
   auto travel_limit = [&](Real h) {
     if (opt.travel <= 0) return h;
-    const std::vector<Real> gaps = flow.body_gaps();
-    for (std::size_t k = 0; k < nb; ++k) {
-      const Real speed = flow.body_velocity(k).template head<Flow::D>().norm();
-      if (speed > 0 && std::isfinite(gaps[k]) && gaps[k] > 0) h = std::min(h, opt.travel * gaps[k] / speed);
-    }
+    for (Real tc : flow.body_times_to_contact())
+      if (tc > 0 && std::isfinite(tc)) h = std::min(h, opt.travel * tc);
     return h;
   };
   auto log = [&](const std::string& text) {
@@ -345,6 +345,8 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
     sum.dt_smallest = std::min(sum.dt_smallest, h_try), sum.dt_largest = std::max(sum.dt_largest, h_try);
     sum.t_mesh_velocity += rep.t_mesh_velocity, sum.t_assembly += rep.t_assembly;
     sum.t_factorize += rep.t_factorize, sum.t_solve += rep.t_solve, sum.t_remesh += rep.t_remesh;
+    sum.linear.factorisations += rep.linear.factorisations, sum.linear.reused += rep.linear.reused;
+    sum.linear.krylov_iterations += rep.linear.krylov_iterations;
     const Real q = flow.worst_quality();
     sum.worst_quality = std::min(sum.worst_quality, q);
     const std::vector<Real> gaps = flow.body_gaps();

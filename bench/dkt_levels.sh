@@ -33,7 +33,7 @@ for exe in $exes; do
       dir="$out/${exe}_o${offset}_L$l"
       if [[ "$rerun" == 1 || ! -s "$dir.log" ]] || ! grep -q "^wall" "$dir.log"; then
         echo "== $exe L$l (h_body $hb, h_far $hf, dt $dt, offset $offset, spring range $spring), load $(cut -d' ' -f1-3 /proc/loadavg)"
-        OPENBLAS_NUM_THREADS=1 /usr/bin/time -v "$build/examples/$exe" --h-body "$hb" --h-far "$hf" --dt "$dt" \
+        OPENBLAS_NUM_THREADS=1 /usr/bin/time -v "$build/examples/$exe" --h-body "$hb" --h-far "$hf" --dt "$dt" --tolerance 0 \
           --t-end "$t_end" --offset "$offset" --spring-range "$spring" --output "$dir" --vtu-every 0 \
           --checkpoint-every 0 > "$dir.log" 2> "$dir.time" || echo "$exe L$l offset $offset failed"
       fi

@@ -33,7 +33,9 @@
 //       scheme and linearisation (Newton, semi-implicit), E at T (velocity L2 against the FD
 //       reference and against the fine-dt FEM solution: BDF3/BDF3E with Newton at
 //       dt = DT 2^-KR) and the run's wall and CPU time (process CPU time, std::clock) for
-//       dt = DT 2^-k, k = 0..K. Plot: docs/img/annulus_speed_plot.py.
+//       dt = DT 2^-k, k = 0..K. Plot: docs/img/annulus_speed_plot.py. With --tolerances T1,T2,...
+//       also adaptive runs (run(): error control, PI controller, first step --dt-first) of the
+//       BDF schemes, the same measures beside steps, rejections and the range of dt.
 //   annulus fig7 [--pair th|gls] [--h H] [--dt DT] [--scheme S] [--csv FILE]
 //       Figure 7: mu = rho_f = 1, t* (the inner cylinder reaches omega = 1/2, half the final
 //       value) against I^ = rho_1 / 64 for rho_1 = 1e-6 .. 1e2, FEM (MR/AB as in the paper)
@@ -101,6 +103,8 @@ struct Settings {
   Real h = 0.04, h_wall = 0;  // h_wall > 0: graded towards the outer wall, h(x) = min(h, h_wall + 0.25 (R2 - |x|))
   int kmax = 4, kref = -1;
   Real dt0 = 0.05, T = 0.8, dt = 0.002;
+  std::vector<Real> tolerances;  // speed: adaptive runs (run()) at these tolerances
+  Real dt_first = 1e-4;          // their first step
   Linearisation lin = Linearisation::newton;
 };
 
@@ -119,6 +123,23 @@ void simulate_with(const Mesh<2>& mesh, const Scene& sc, Real dt, int n, Lineari
     const StepReport rep = flow.step(dt);
     obs(flow, k, rep);
   }
+}
+// Advances to T by run() with adaptive steps (tolerance tol, first step dt_first) and calls
+// obs(flow, summary) at T.
+template <class Pair, class Scheme, class Obs>
+void simulate_adaptive(const Mesh<2>& mesh, const Scene& sc, Real tol, Real dt_first, Real T, Linearisation lin,
+                       Obs&& obs) {
+  FlowOptions fo{sc.rho, sc.mu, lin, 25, 1e-10, sc.damped_start};
+  fo.tau_dt = dt_first;  // P1/P1-GLS: tau must not change with the steps
+  AleFlow<FlowConfig<2, Pair, Scheme, NavierStokes, Solver>> flow(mesh, fo);
+  const scenes::Annulus an = sc.annulus();
+  an.configure(flow);
+  if (sc.wall_moving_at_0 && sc.omega2(0) != 0) an.start_with_moving_wall(flow);
+  RunOptions ro;
+  ro.dt = dt_first, ro.t_end = T, ro.tolerance = tol, ro.progress_every = 0, ro.log = nullptr;
+  ro.velocity_scale = sc.r2;  // the outer wall's final speed (omega_2 -> 1): the flow starts from rest
+  const RunSummary sum = run(flow, ro);
+  obs(flow, sum);
 }
 template <class Pair, class Scheme, class Obs>
 void simulate(const Mesh<2>& mesh, const Scene& sc, Real dt, int n, Linearisation lin, Obs&& obs) {
@@ -300,7 +321,7 @@ int speed_error(const Scene& sc, const Settings& s, const std::vector<Linearisat
   std::ofstream csv;
   if (!s.csv.empty()) {
     csv.open(s.csv);
-    csv << "scheme,linearisation,k,dt,steps,E_fd,E_time,omega_err_fd,newton_avg,wall_s,cpu_s\n";
+    csv << "scheme,linearisation,k,dt,steps,E_fd,E_time,omega_err_fd,newton_avg,wall_s,cpu_s,tolerance\n";
   }
   std::printf("\n| scheme | linearisation | dt | E vs FD | E vs fine-dt FEM | iterations/step | wall (s) | CPU (s) |\n"
               "|---|---|---|---|---|---|---|---|\n");
@@ -333,7 +354,41 @@ int speed_error(const Scene& sc, const Settings& s, const std::vector<Linearisat
                     Real(its) / n, wall, cpu);
         if (csv.is_open())
           csv << key << ',' << ln << ',' << k << ',' << dt << ',' << n << ',' << efd << ',' << et << ',' << ew << ','
-              << Real(its) / n << ',' << wall << ',' << cpu << '\n'
+              << Real(its) / n << ',' << wall << ',' << cpu << ",0\n"
+              << std::flush;
+      }
+  // adaptive steps (run()), the same measures; MR/AB has none (theory.md 9.1)
+  if (!s.tolerances.empty())
+    std::printf("\n| scheme | linearisation | tolerance | steps (rejected) | dt min .. max | E vs FD | E vs fine-dt FEM | "
+                "wall (s) | CPU (s) |\n|---|---|---|---|---|---|---|---|---|\n");
+  for (Linearisation lin : lins)
+    for (const auto& key : s.schemes)
+      for (Real tol : s.tolerances) {
+        if (key == "MR_AB") continue;
+        Real efd = NAN, et = NAN, ew = NAN, wall = 0, cpu = 0;
+        RunSummary sum;
+        try {
+          with_types(s.pair, key, [&]<class Pair, class Scheme>() {
+            const auto w0 = Clock::now();
+            const std::clock_t c0 = std::clock();
+            simulate_adaptive<Pair, Scheme>(mesh, sc, tol, s.dt_first, s.T, lin, [&](const auto& flow, const RunSummary& r) {
+              wall = std::chrono::duration<double>(Clock::now() - w0).count();
+              cpu = Real(std::clock() - c0) / CLOCKS_PER_SEC;
+              sum = r;
+              efd = error_vs_fd(flow, fd), et = error_vs_field(flow, uref);
+              ew = std::abs(flow.body_velocity(0)[2] - fd.omega());
+            });
+          });
+        } catch (const Error& e) {
+          std::printf("| %s | tol %g | failed: %s |\n", display_name(key), tol, e.what());
+          continue;
+        }
+        const char* ln = lin == Linearisation::newton ? "newton" : "semi";
+        std::printf("| %s | %s | %.0e | %d (%d) | %.1e .. %.1e | %.4e | %.4e | %.2f | %.2f |\n", display_name(key), ln, tol,
+                    sum.steps, sum.rejected, sum.dt_smallest, sum.dt_largest, efd, et, wall, cpu);
+        if (csv.is_open())
+          csv << key << ',' << ln << ",-1," << sum.dt_largest << ',' << sum.steps << ',' << efd << ',' << et << ','
+              << ew << ",," << wall << ',' << cpu << ',' << tol << '\n'
               << std::flush;
       }
   return 0;
@@ -420,6 +475,8 @@ int main(int argc, char** argv) try {
       .add("ref-scheme", s.ref_scheme, "scheme of the fine-dt FEM reference")
       .add("lin", lin, "newton or semi (table1, smooth, fig7)")
       .add("lins", lins, "linearisations of the speed study")
+      .add("tolerances", s.tolerances, "speed: also adaptive runs (run()) at these error tolerances")
+      .add("dt-first", s.dt_first, "speed: the adaptive runs' first step")
       .add("csv", s.csv, "CSV file of the results")
       .add("mu", sc.mu, "viscosity")
       .add("rho-s", sc.rho_s, "density of the inner cylinder")

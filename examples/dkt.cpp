@@ -20,8 +20,13 @@
 // default P1P1Gls + BDF2_BDF2E as in the paper's Figure 5; dkt_config.hpp), its flow and the
 // scene's mesh and set-up compiled once in dkt_flow.cpp (alefsi/sim/instantiate.hpp); the scene is
 // alefsi/scenes/settling.hpp's; at run time (`./dkt --help` lists every option with its
-// default): --dt, --t-end, --h-body, --h-far, --offset, --spring-range, --output, --vtu-every,
-// --checkpoint-every, --threads, --restart FILE, --newton, --no-collisions, --no-remeshing.
+// default): --dt, --tolerance, --t-end, --h-body, --h-far, --offset, --spring-range, --output,
+// --vtu-every, --checkpoint-every, --threads, --restart FILE, --newton, --no-collisions,
+// --no-remeshing.
+// Steps: adaptive by default (run()'s error control, tolerance 1e-3 of the velocity scale;
+// --dt is the first step), landing on t = 0.1, 0.2, 0.3 s for the position samples;
+// --tolerance 0 gives a fixed --dt (the level studies, bench/dkt_levels.sh). With MR/AB
+// (ALEFSI_DKT_SCHEME=MR_AB) the steps are fixed.
 // --threads T: the flow system is assembled on T threads (FlowOptions::threads; the
 // results are the same to the last bit, only the assembly time changes).
 // What it prints: the mesh size, then a progress line every 10 steps (t, dt, Newton
@@ -51,11 +56,15 @@ using Flow = AleFlow<Config>;
 
 int main(int argc, char** argv) try {
   Real dt = 1e-3, t_end = 0.5, h_body = 0.02, h_far = 0.15, offset = 0.001, spring_range = 0.04;
+  Real tolerance = Config::Scheme::theta == 1 ? RunOptions::default_tolerance : 0.0;  // MR/AB: fixed dt
+  Real tau_dt = -1;  // -1: 1e-3 (the paper's step at the default mesh) when adaptive, else each step's dt
   std::filesystem::path out = "output/dkt", restart;
   int vtu_every = 50, checkpoint_every = 100, threads = 1;
-  bool newton = false, collisions = true, remeshing = true;
+  bool newton = false, collisions = true, remeshing = true, reuse = true;
   Options opt("dkt", "Drafting, kissing and tumbling of two disks settling in a 2 x 6 cm channel (paper 6.2).");
-  opt.add("dt", dt, "time step (s)")
+  opt.add("dt", dt, "time step (s); with --tolerance > 0 the first one")
+      .add("tolerance", tolerance, "local error tolerance of adaptive steps, relative to the velocity scale (0: fixed dt)")
+      .add("tau-dt", tau_dt, "P1/P1-GLS: a fixed step in the GLS parameter tau (s; -1: 1e-3 if adaptive, 0: each step's dt)")
       .add("t-end", t_end, "final time (s)")
       .add("h-body", h_body, "mesh size at the disks (cm)")
       .add("h-far", h_far, "mesh size far from the disks (cm)")
@@ -68,7 +77,8 @@ int main(int argc, char** argv) try {
       .add("restart", restart, "continue from this checkpoint")
       .flag("newton", newton, "Newton's method instead of the semi-implicit linearisation")
       .flag("collisions", collisions, "collision forces (eq. 24 + spring)")
-      .flag("remeshing", remeshing, "remeshing in the time loop");
+      .flag("remeshing", remeshing, "remeshing in the time loop")
+      .flag("reuse", reuse, "reuse factorisations across steps (GMRES preconditioned by an earlier one)");
   if (!opt.parse(argc, argv, std::cout)) return 0;
   opt.print(std::cout);
   // --- the scene ------------------------------------------------------------------------
@@ -90,7 +100,8 @@ int main(int argc, char** argv) try {
 
   Flow flow(std::move(mesh), {.rho = scene.rho_f, .mu = 0.01,
                               .linearisation = newton ? Linearisation::newton : Linearisation::semi_implicit,
-                              .threads = threads});
+                              .threads = threads, .tau_dt = tau_dt >= 0 ? tau_dt : tolerance > 0 ? 1e-3 : 0.0,
+                              .reuse_factorisation = reuse});
   scene.configure(flow, h_body, h_far);
   if (!restart.empty()) {
     flow.load_checkpoint(restart);
@@ -103,8 +114,8 @@ int main(int argc, char** argv) try {
   Real t_kiss = -1, gap_kiss = 0;
   std::array<Real, 3> ts_last{0, 0, 0}, gs_last{1e300, 1e300, 1e300};  // the last three (t, gap)
   std::vector<std::pair<Real, std::array<Vec<2>, 2>>> snaps;
-  RunOptions ro{.dt = dt, .t_end = t_end, .output = out, .vtu_every = vtu_every,
-                .checkpoint_every = checkpoint_every};
+  RunOptions ro{.dt = dt, .t_end = t_end, .tolerance = tolerance, .land_on = {0.1, 0.2, 0.3}, .output = out,
+                .vtu_every = vtu_every, .checkpoint_every = checkpoint_every};
   ro.on_step = [&] {
     const Real gap = (flow.body_centre(0) - flow.body_centre(1)).norm() - 2 * R;
     ts_last = {ts_last[1], ts_last[2], flow.time()}, gs_last = {gs_last[1], gs_last[2], gap};
@@ -116,23 +127,26 @@ int main(int argc, char** argv) try {
       t_kiss = ts_last[1] - s, gap_kiss = gs_last[1];
     }
     for (Real ts : {0.1, 0.2, 0.3})
-      if (std::abs(flow.time() - ts) < 0.5 * dt) snaps.push_back({ts, {flow.body_centre(0), flow.body_centre(1)}});
+      if (std::abs(flow.time() - ts) < 1e-9) snaps.push_back({ts, {flow.body_centre(0), flow.body_centre(1)}});
   };
   const RunSummary s = run(flow, ro);
 
   std::cout << std::fixed << std::setprecision(4) << "\nreached t = " << s.t << " in " << s.steps << " steps ("
             << s.rejected << " rejected), " << s.remeshes << " remeshes, worst quality " << s.worst_quality
-            << ", smallest gap " << std::scientific << std::setprecision(3) << s.min_gap << "\n";
-  std::cout << std::fixed << std::setprecision(4) << "kissing time (first minimum of the gap): ";
+            << ", smallest gap " << std::scientific << std::setprecision(3) << s.min_gap << ", dt " << std::setprecision(2)
+            << s.dt_smallest << " to " << s.dt_largest << " (" << s.error_rejections << " rejected by the error estimate)\n";
+  std::cout << std::fixed << std::setprecision(6) << "kissing time (first minimum of the gap): ";
   if (t_kiss < 0) std::cout << "not reached\n";
   else std::cout << t_kiss << " s, gap " << std::scientific << std::setprecision(3) << gap_kiss << " cm\n";
-  std::cout << std::fixed << std::setprecision(4);
+  std::cout << std::fixed << std::setprecision(6);
   for (const auto& [ts, x] : snaps)
     std::cout << "t = " << ts << ": upper (" << x[0][0] << ", " << x[0][1] << "), lower (" << x[1][0] << ", "
               << x[1][1] << ")\n";
   std::cout << std::setprecision(2) << "wall " << s.wall_seconds << " s: mesh velocity " << s.t_mesh_velocity
             << ", assembly " << s.t_assembly << ", factorisation " << s.t_factorize << ", solve " << s.t_solve
             << ", remeshing " << s.t_remesh << "\n";
+  std::cout << "linear solves: " << s.linear.factorisations << " factorisations, " << s.linear.reused
+            << " solves reusing one (" << s.linear.krylov_iterations << " GMRES iterations)\n";
   return 0;
 } catch (const std::exception& e) {
   std::cerr << "dkt: " << e.what() << "\n";

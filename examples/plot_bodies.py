@@ -5,7 +5,8 @@ usage: python3 examples/plot_bodies.py DIR [DIR2 ...] [--labels a,b,...] [--out 
                                       [--differences] [--spread DIR_A,DIR_B,LABEL ...]
 
 Writes PREFIX_positions.png (x and y of every body against t), PREFIX_velocities.png
-(V1, V2 and w against t) and PREFIX_trajectories.png (the paths in the x-y plane). With
+(V1, V2 and w against t), PREFIX_trajectories.png (the paths in the x-y plane) and
+PREFIX_steps.png (dt against t, remeshes marked). With
 several folders (e.g. mesh / dt levels) the curves are overlaid. PREFIX defaults to
 DIR/dkt. With --differences also PREFIX_differences.png: for each pair of successive folders
 the largest distance between the positions of a body in the two runs against t (log scale),
@@ -110,6 +111,19 @@ def main(argv):
     fig.tight_layout()
     fig.savefig(f"{out}_trajectories.png", dpi=120)
     print(f"wrote {out}_positions.png, {out}_velocities.png, {out}_trajectories.png")
+
+    # the steps: dt against t (adaptive runs vary it; remeshes marked)
+    fig, ax = plt.subplots(figsize=(6.5, 3.5))
+    for (c, _), lab, ls in zip(data, labels, styles * 4):
+        ax.semilogy(c["t"], c["dt"], ls, label=lab)
+        rt = [t for t, r in zip(c["t"], c["remeshed"]) if r > 0]
+        rd = [d for d, r in zip(c["dt"], c["remeshed"]) if r > 0]
+        ax.semilogy(rt, rd, "k.", ms=3)
+    ax.set_xlabel("t [s]"), ax.set_ylabel("dt [s] (dots: remeshes)"), ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(f"{out}_steps.png", dpi=120)
+    print(f"wrote {out}_steps.png")
 
     if differences:
         fig, ax = plt.subplots(figsize=(6.5, 4))

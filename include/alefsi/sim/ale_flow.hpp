@@ -80,8 +80,7 @@ struct StepReport {
     residuals.insert(residuals.end(), r.residuals.begin(), r.residuals.end());
     t_mesh_velocity += r.t_mesh_velocity, t_assembly += r.t_assembly, t_factorize += r.t_factorize;
     t_solve += r.t_solve, t_remesh += r.t_remesh;
-    linear.factorisations += r.linear.factorisations, linear.reused += r.linear.reused;
-    linear.krylov_iterations += r.linear.krylov_iterations;
+    linear += r.linear;
   }
 };
 
@@ -450,7 +449,7 @@ class AleFlow {
       const auto& body = s.bodies[b];
       Real L = 0;
       for (const Vec<D>& r : body.surface) L = std::max(L, r.norm());
-      const BodyVelocity Z = bodies_.next_velocity(b, disc_.constraints(), u, t1);
+      const BodyVelocity Z = bodies_.next_velocity(b, cons, u, t1);
       BodyVelocity P = BodyVelocity::Zero();
       for (int k = 0; k < w.points; ++k) P += w.predictor[std::size_t(k)] * body.velocity[k];
       const BodyVelocity e = w.constant * (Z - P);

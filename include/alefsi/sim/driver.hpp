@@ -345,8 +345,7 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
     sum.dt_smallest = std::min(sum.dt_smallest, h_try), sum.dt_largest = std::max(sum.dt_largest, h_try);
     sum.t_mesh_velocity += rep.t_mesh_velocity, sum.t_assembly += rep.t_assembly;
     sum.t_factorize += rep.t_factorize, sum.t_solve += rep.t_solve, sum.t_remesh += rep.t_remesh;
-    sum.linear.factorisations += rep.linear.factorisations, sum.linear.reused += rep.linear.reused;
-    sum.linear.krylov_iterations += rep.linear.krylov_iterations;
+    sum.linear += rep.linear;
     const Real q = flow.worst_quality();
     sum.worst_quality = std::min(sum.worst_quality, q);
     const std::vector<Real> gaps = flow.body_gaps();

@@ -70,6 +70,10 @@ struct LinearSolveCounts {
   int factorisations = 0;     ///< numeric factorisations
   int reused = 0;             ///< solves by GMRES on an earlier factorisation
   int krylov_iterations = 0;  ///< their GMRES iterations
+  LinearSolveCounts& operator+=(const LinearSolveCounts& o) {
+    factorisations += o.factorisations, reused += o.reused, krylov_iterations += o.krylov_iterations;
+    return *this;
+  }
 };
 
 struct NewtonReport {

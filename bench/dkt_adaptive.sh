@@ -3,7 +3,8 @@
 # each run's positions at t = 0.1, 0.2, 0.3 s and kissing time against a reference run with a
 # small fixed dt on the same initial mesh and with the same GLS tau, beside its steps, wall and
 # CPU time
-# (docs/performance.md, "Adaptive steps").
+# (docs/results.md, "Adaptive steps against a fixed dt"); the table also goes to OUT_DIR/summary.csv
+# (plot: docs/img/fixed_adaptive_plot.py).
 # Needs the dkt example built: cmake --preset release && cmake --build --preset release --target dkt
 # usage: bench/dkt_adaptive.sh [OUT_DIR] [LEVEL] [T_END]
 #   defaults: build/release/output/dkt_adaptive  2  0.3
@@ -79,6 +80,8 @@ print(f"DKT level {level}, reference: fixed dt {ref_dt} ({ref['steps']} steps, {
       f"kiss {ref['kiss']:.5f} s")
 print("| run | steps (rejected) | remeshes | wall s | CPU s | peak MB | position error t=0.1 | t=0.2 | t=0.3 | kiss error ms |")
 print("|---|---|---|---|---|---|---|---|---|---|")
+csv = open(f"{out}/summary.csv", "w")
+csv.write("run,kind,value,steps,rejected,remeshes,wall_s,cpu_s,peak_mb,err_t0.1,err_t0.2,err_t0.3,kiss_err_ms\n")
 for name in [f"fixed_dt{d}" for d in dts] + [f"adaptive_tol{t}" for t in tols]:
     try:
         r = parse(name)
@@ -89,4 +92,8 @@ for name in [f"fixed_dt{d}" for d in dts] + [f"adaptive_tol{t}" for t in tols]:
     print(f"| {name.replace('_', ' ')} | {r['steps']} ({r['rejected']}) | {r['remeshes']} | {r['wall']:.1f} | "
           f"{r['cpu']:.1f} | {r['rss']:.0f} | {e[0]:.1e} | {e[1]:.1e} | {e[2]:.1e} | "
           f"{1e3 * abs(r['kiss'] - ref['kiss']):.3f} |")
+    kind, value = name.split("_")
+    csv.write(f"{name},{kind},{value.lstrip('dtol')},{r['steps']},{r['rejected']},{r['remeshes']},{r['wall']:.2f},"
+              f"{r['cpu']:.2f},{r['rss']:.0f},{e[0]:.3e},{e[1]:.3e},{e[2]:.3e},{1e3 * abs(r['kiss'] - ref['kiss']):.4f}\n")
+print(f"wrote {out}/summary.csv")
 EOF

@@ -11,7 +11,7 @@
 // How to run:
 //   annulus table1 [--schemes MR_AB,...] [--pair th|gls] [--h H] [--h-wall HW] [--kmax K]
 //                  [--kref KR] [--ref-scheme S] [--lin newton|semi] [--wall-start moving|rest]
-//                  [--damped-start M] [--csv FILE]
+//                  [--damped-start M] [--start-up midpoint|bdf] [--graded-start F] [--csv FILE]
 //       Table 1: mu = 0.01, rho = 1, rho_1 = 1.25; E = ||u(0.8) - u_h(0.8)||_L2(Omega_h(0.8))
 //       for dt = 0.05 2^-k, k = 0..K, with orders, (a) against the FD reference (N = 6000 cells,
 //       dt = 0.05 / 1024: its own error is ~1e-7) and (b) against a fine-dt FEM solution on the
@@ -22,7 +22,10 @@
 //       O(dt) late and every scheme is first order; docs/results.md). --damped-start M: the
 //       first step of every run (the fine-dt reference too) as M backward-Euler substeps
 //       (FlowOptions::damped_start, Rannacher's start; extrapolated for BDF3); default 0: the
-//       multistep start-up (MR/AB steps), which does not damp the wall jump. --convection off:
+//       multistep start-up (MR/AB steps), which does not damp the wall jump. --start-up bdf: the
+//       BDF schemes' start-up steps are BSS then BDF2/BDF2E (FlowOptions::start_up); --graded-start F:
+//       every fixed-dt run (the reference too) first grows its steps from F dt (dt/dt0)^((q-2)/2)
+//       to dt (time/step_sequence.hpp), then keeps dt. --convection off:
 //       unsteady Stokes instead of Navier-Stokes (a diagnostic; every mode accepts it).
 //   annulus smooth [same options] [--mu M] [--rho-s R] [--ramp TAU] [--T T] [--dt0 DT]
 //       Time-order study that exercises the coupling: mu = 1, rho_1 = 1.25 (Figure 7 set-up),
@@ -81,6 +84,10 @@ struct Scene {
   // step turns into a ramp over [0, dt]: the flow starts O(dt) late and every scheme is O(dt).
   bool wall_moving_at_0 = true;
   int damped_start = 0;  // FlowOptions::damped_start: 0 = the multistep start-up, M = M backward-Euler substeps
+  StartUp start_up = StartUp::midpoint;  // FlowOptions::start_up: the multistep start-up's formulas
+  // > 0: fixed-dt runs start with graded_start (time/step_sequence.hpp) from the first step
+  // graded dt (dt / graded_dt0)^((q - 2) / 2), q the scheme's order (simulate_with)
+  Real graded = 0, graded_dt0 = 0.05;
   bool convection = true;  // false: unsteady Stokes (a diagnostic: no advection of start-up errors)
   Real omega2(Real t) const { return ramp > 0 ? 1 - std::exp(-std::pow(t / ramp, 4)) : 1.0; }
   // the physical set-up (alefsi/scenes/annulus.hpp)
@@ -115,11 +122,21 @@ Mesh<2> make_mesh(const Scene& sc, const Settings& s) { return sc.annulus().mesh
 template <class Pair, class Scheme, bool Convection, class Obs>
 void simulate_with(const Mesh<2>& mesh, const Scene& sc, Real dt, int n, Linearisation lin, Obs&& obs) {
   using Equations = std::conditional_t<Convection, NavierStokes, UnsteadyStokes>;
-  AleFlow<FlowConfig<2, Pair, Scheme, Equations, Solver>> flow(mesh, FlowOptions{sc.rho, sc.mu, lin, 25, 1e-10, sc.damped_start});
+  FlowOptions fo{sc.rho, sc.mu, lin, 25, 1e-10, sc.damped_start};
+  fo.start_up = Scheme::theta == 1 ? sc.start_up : StartUp::midpoint;  // MR/AB starts with its own
+  AleFlow<FlowConfig<2, Pair, Scheme, Equations, Solver>> flow(mesh, fo);
   const scenes::Annulus an = sc.annulus();
   an.configure(flow);
   if (sc.wall_moving_at_0 && sc.omega2(0) != 0) an.start_with_moving_wall(flow);
-  for (int k = 1; k <= n; ++k) {
+  int k0 = 1;  // the first step on the grid k dt
+  if (sc.graded > 0) {
+    // first step F dt (dt / dt0)^((q - 2) / 2): the start-up BSS step's error, O(first^2), is O(dt^q)
+    const Real first = sc.graded * dt * std::pow(dt / sc.graded_dt0, (Scheme::order - 2) / 2.0);
+    Real sum = 0;
+    for (Real h : graded_start(dt, first, max_step_ratio<Scheme>())) flow.step(h), sum += h;
+    k0 = int(std::lround(sum / dt)) + 1;
+  }
+  for (int k = k0; k <= n; ++k) {
     const StepReport rep = flow.step(dt);
     obs(flow, k, rep);
   }
@@ -130,6 +147,7 @@ template <class Pair, class Scheme, class Obs>
 void simulate_adaptive(const Mesh<2>& mesh, const Scene& sc, Real tol, Real dt_first, Real T, Linearisation lin,
                        Obs&& obs) {
   FlowOptions fo{sc.rho, sc.mu, lin, 25, 1e-10, sc.damped_start};
+  fo.start_up = Scheme::theta == 1 ? sc.start_up : StartUp::midpoint;  // MR/AB starts with its own
   fo.tau_dt = dt_first;  // P1/P1-GLS: tau must not change with the steps
   AleFlow<FlowConfig<2, Pair, Scheme, NavierStokes, Solver>> flow(mesh, fo);
   const scenes::Annulus an = sc.annulus();
@@ -212,8 +230,12 @@ void print_start(const Scene& sc) {
   if (sc.damped_start > 0)
     std::printf("start-up: damped, the first step as %d backward-Euler substeps (extrapolated for order >= 3), every run\n",
                 sc.damped_start);
-  else
-    std::printf("start-up: the multistep one (MR/AB start-up steps)\n");
+  const char* steps = sc.start_up == StartUp::bdf ? "BSS, BDF2/BDF2E start-up steps for the BDF schemes" : "MR/AB start-up steps";
+  if (sc.damped_start == 0) std::printf("start-up: the multistep one (%s)\n", steps);
+  else std::printf("  then %s\n", steps);
+  if (sc.graded > 0)
+    std::printf("graded start: fixed-dt runs grow from %g dt (dt / %g)^((q - 2) / 2) to dt (time/step_sequence.hpp)\n",
+                sc.graded, sc.graded_dt0);
 }
 
 // --- Table 1 and the smooth-start study --------------------------------------------------------
@@ -462,6 +484,7 @@ int main(int argc, char** argv) try {
   if (mode == "smooth") sc.mu = 1, sc.ramp = 0.1, s.T = 0.4, s.dt0 = 0.02, s.h = 0.05;
   if (mode == "speed") sc.mu = 1, sc.ramp = 0.1, s.T = 0.4, s.dt0 = 0.02, s.h = 0.08;
   if (mode == "fig7") sc.mu = 1, s.schemes = {"MR_AB"};
+  std::string start_up = "midpoint";
   std::string lin = "newton", wall_start = sc.wall_moving_at_0 ? "moving" : "rest", convection = "on";
   std::vector<std::string> lins = {"newton", "semi"};
   Options opt("annulus", "The paper's annulus (section 6.3); modes table1, smooth, speed, fig7 (see the file comment).");
@@ -486,8 +509,12 @@ int main(int argc, char** argv) try {
       .add("dt", s.dt, "time step (fig7)")
       .add("wall-start", wall_start, "the initial FE velocity on the outer wall: moving or rest")
       .add("damped-start", sc.damped_start, "the first step as M backward-Euler substeps (0: multistep start-up)")
+      .add("start-up", start_up, "the multistep start-up's formulas: midpoint (MR/AB) or bdf (BSS, BDF2; BDF schemes)")
+      .add("graded-start", sc.graded,
+           "fixed-dt runs: the first steps grow from F dt (dt / dt0)^((q - 2) / 2) to dt, q the order (0: none)")
       .add("convection", convection, "on, or off (unsteady Stokes: a diagnostic)");
   if (!opt.parse(argc, argv, std::cout)) return 0;
+  sc.graded_dt0 = s.dt0;
   opt.print(std::cout);
   auto linearisation = [](const std::string& l) {
     if (l != "newton" && l != "semi") throw InvalidArgument("--lin", "newton or semi, got " + l);
@@ -497,6 +524,8 @@ int main(int argc, char** argv) try {
   std::vector<Linearisation> lin_list;
   for (const auto& l : lins) lin_list.push_back(linearisation(l));
   sc.wall_moving_at_0 = wall_start != "rest";
+  if (start_up != "midpoint" && start_up != "bdf") throw InvalidArgument("--start-up", "midpoint or bdf, got " + start_up);
+  sc.start_up = start_up == "bdf" ? StartUp::bdf : StartUp::midpoint;
   sc.convection = convection != "off";
   if (mode == "table1") return time_orders(sc, s, true);
   if (mode == "smooth") return time_orders(sc, s, false);

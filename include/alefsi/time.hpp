@@ -7,3 +7,4 @@
 #include "alefsi/time/stepper.hpp"
 #include "alefsi/time/error_estimate.hpp"
 #include "alefsi/time/step_controller.hpp"
+#include "alefsi/time/step_sequence.hpp"

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <complex>
 #include <string>
+#include <vector>
 
 #include "alefsi/time.hpp"
 
@@ -135,6 +136,45 @@ TEST_CASE("Stepper: start-up while the history is short, a damped start when ask
   CHECK(p.coefficients.dt == 0.005);
   CHECK(!Stepper<BDF2_BDF2E>(2).plan(TimeHistory{}, 0.02).richardson);
   CHECK_THROWS_WITH(Stepper<MR_AB>(3), Catch::Contains("damped_start"));
+
+  // BDF start-up: BSS (back-filling), then BDF2/BDF2E, then the scheme's own; not for MR/AB
+  const Stepper<BDF3_BDF3E> bdf_start(0, true, StartUp::bdf);
+  TimeHistory g;
+  p = bdf_start.plan(g, 1e-4);
+  CHECK((p.kind == StepKind::startup && p.coefficients.backfill));
+  CHECK(std::string(p.coefficients.scheme) == BSS::name);
+  g.advance(1e-4);
+  p = bdf_start.plan(g, 1.3e-4);
+  CHECK((p.kind == StepKind::startup && !p.coefficients.backfill));
+  CHECK(std::string(p.coefficients.scheme) == BDF2_BDF2E::name);
+  g.advance(1.3e-4);
+  CHECK(bdf_start.plan(g, 1.6e-4).kind == StepKind::regular);
+  CHECK(std::string(Stepper<BDF2_AB>(2, false, StartUp::bdf).plan(history({0.01}), 0.01).coefficients.scheme) ==
+        BDF2_AB::name);
+  CHECK_THROWS_WITH(Stepper<MR_AB>(0, true, StartUp::bdf), Catch::Contains("start_up"));
+}
+
+TEST_CASE("graded_start: geometric growth within the ratio bound, ending on the grid k dt", "[time][stepper][quick]") {
+  for (Real bound : {1.5, 2.0}) {
+    for (Real first : {1e-6, 1e-3, 0.3}) {
+      const Real dt = 0.01;
+      const std::vector<Real> s = graded_start(dt, first * dt, bound);
+      REQUIRE(!s.empty());
+      Real sum = 0;
+      for (std::size_t j = 0; j < s.size(); ++j) {
+        sum += s[j];
+        if (j > 0) CHECK(s[j] / s[j - 1] <= 0.9 * bound * (1 + 1e-12));
+      }
+      CHECK(s.front() >= first * dt);
+      CHECK(s.front() < 2 * first * dt);                  // scaled up by c <= 1 + dt / S < 2
+      CHECK(dt / s.back() <= 0.9 * bound * (1 + 1e-12));  // into the first regular step
+      const Real k = std::round(sum / dt);
+      CHECK(k >= 1);
+      CHECK(std::abs(sum - k * dt) <= 1e-15);
+    }
+  }
+  CHECK(graded_start(0.01, 0.01, 1.5).empty());
+  CHECK_THROWS_WITH(graded_start(0.01, 0, 1.5), Catch::Contains("first"));
 }
 
 namespace {

@@ -23,6 +23,7 @@
 #include "alefsi/physics/navier_stokes.hpp"
 #include "alefsi/physics/rigid_body.hpp"
 #include "alefsi/time/schemes.hpp"
+#include "alefsi/time/stepper.hpp"
 
 namespace alefsi {
 
@@ -123,6 +124,12 @@ struct FlowOptions {
   /// false: every solve factorises (the results differ at the 1e-13 level). Checkpoints keep the
   /// factorised matrix, so a continued run is bit for bit the uninterrupted one either way.
   bool reuse_factorisation = true;
+  /// The start-up steps' formulas (time/stepper.hpp), taken while the history is shorter than
+  /// the scheme reads (after the damped start, if any): MR/AB's (default, the paper's), or for
+  /// the BDF schemes (theta = 1) BSS then BDF2/BDF2E (`StartUp::bdf`), which are L-stable and
+  /// damp what an impulsive start leaves; their lower order costs nothing when the first steps
+  /// are small (an adaptive run from a small dt, or a graded start: time/step_sequence.hpp).
+  StartUp start_up = StartUp::midpoint;
 
   void validate() const {
     ALEFSI_CHECK_ARG(rho >= 0 && std::isfinite(rho), "rho", "fluid density must be >= 0 and finite, got ", rho);

@@ -20,8 +20,10 @@
 /// with w = dt_n / dt_{n-1}: a = ((1 + 2w)/(1 + w), -(1 + w), w^2/(1 + w))).
 ///
 /// `Stepper<S>` decides how the next step is taken: with the scheme's own coefficients, or, while
-/// the history holds fewer levels than the scheme reads, with MR/AB start-up coefficients
-/// (self-starting; the very first one back-fills level n-1, `StepCoefficients::backfill`), or
+/// the history holds fewer levels than the scheme reads, with start-up coefficients (self-starting;
+/// the very first one back-fills level n-1, `StepCoefficients::backfill`): MR/AB's
+/// (`StartUp::midpoint`), or for the BDF schemes BDF of the order the history allows, BSS then
+/// BDF2/BDF2E (`StartUp::bdf`: L-stable, so a start that is not smooth is damped), or
 /// as a damped start (m backward-Euler substeps, Richardson-extrapolated for design order >= 3;
 /// sim/ale_flow.hpp carries it out). With constant steps (the default) a change of dt restarts
 /// the history; with variable steps (`Stepper(m, true)`) the variable-step formulas take it,
@@ -165,18 +167,28 @@ struct StepPlan {
   bool richardson = false;        ///< damped_start: extrapolate m and m/2 substeps (order >= 3)
 };
 
+/// The formulas of the start-up steps, taken while the history is shorter than the scheme reads.
+enum class StartUp {
+  midpoint,  ///< MR/AB's (second order; not L-stable: |R(inf)| = 1)
+  bdf,       ///< BDF schemes only: BSS, then BDF2/BDF2E (L-stable; first, then second order)
+};
+
 /// The scheme's driver: which formulas the next step uses (see the file comment).
 template <TimeScheme S>
 class Stepper {
  public:
   using Scheme = S;
   /// `damped_start` = m (even, 2..64), or 0 for the multistep start-up; `variable_steps`: a
-  /// change of dt keeps the history (within the scheme's step-ratio bound).
-  explicit Stepper(int damped_start = 0, bool variable_steps = false)
-      : damped_start_(damped_start), variable_(variable_steps) {
+  /// change of dt keeps the history (within the scheme's step-ratio bound); `start_up`: the
+  /// multistep start-up's formulas (StartUp::bdf needs a BDF scheme, theta = 1).
+  explicit Stepper(int damped_start = 0, bool variable_steps = false, StartUp start_up = StartUp::midpoint)
+      : damped_start_(damped_start), variable_(variable_steps), start_up_(start_up) {
     ALEFSI_CHECK_ARG(damped_start == 0 || (damped_start >= 2 && damped_start <= 64 && damped_start % 2 == 0),
                      "damped_start", "must be 0 (off) or an even number of substeps in 2..64, got ", damped_start);
+    ALEFSI_CHECK_ARG(start_up == StartUp::midpoint || S::theta == 1, "start_up",
+                     "BDF start-up steps need a BDF scheme (theta = 1); ", S::name, " starts with its own formulas");
   }
+  StartUp start_up() const { return start_up_; }
   int damped_start() const { return damped_start_; }
 
   bool variable_steps() const { return variable_; }
@@ -199,7 +211,9 @@ class Stepper {
       p.coefficients = step_coefficients<BSS>(dt / damped_start_, h);
     } else if (h.levels() < history_levels<S>()) {
       p.kind = StepKind::startup;
-      p.coefficients = step_coefficients<MR_AB>(dt, h);
+      p.coefficients = start_up_ == StartUp::midpoint ? step_coefficients<MR_AB>(dt, h)
+                       : h.levels() == 0             ? step_coefficients<BSS>(dt, h)
+                                                     : step_coefficients<BDF2_BDF2E>(dt, h);
       p.coefficients.backfill = h.levels() == 0;
     } else {
       p.coefficients = step_coefficients<S>(dt, h);
@@ -212,6 +226,7 @@ class Stepper {
  private:
   int damped_start_ = 0;
   bool variable_ = false;
+  StartUp start_up_ = StartUp::midpoint;
 };
 
 }  // namespace alefsi

@@ -38,7 +38,8 @@
 //       dt = DT 2^-KR) and the run's wall and CPU time (process CPU time, std::clock) for
 //       dt = DT 2^-k, k = 0..K. Plot: docs/img/annulus_speed_plot.py. With --tolerances T1,T2,...
 //       also adaptive runs (run(): error control, PI controller, first step --dt-first) of the
-//       BDF schemes, the same measures beside steps, rejections and the range of dt.
+//       BDF schemes, the same measures beside steps, rejections and the range of dt (--output DIR:
+//       each adaptive run's step log DIR/<scheme>_<lin>_tol<T>/bodies.csv).
 //   annulus fig7 [--pair th|gls] [--h H] [--dt DT] [--scheme S] [--csv FILE]
 //       Figure 7: mu = rho_f = 1, t* (the inner cylinder reaches omega = 1/2, half the final
 //       value) against I^ = rho_1 / 64 for rho_1 = 1e-6 .. 1e2, FEM (MR/AB as in the paper)
@@ -54,6 +55,7 @@
 #include <cmath>
 #include <ctime>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <numbers>
@@ -107,6 +109,7 @@ struct Scene {
 struct Settings {
   std::vector<std::string> schemes{"MR_AB", "BDF2_BDF2E", "BDF2_AB", "BDF3_BDF3E", "BSS"};
   std::string pair = "th", ref_scheme = "BDF3_BDF3E", csv;
+  std::string output;  // speed: a folder for the adaptive runs' bodies.csv (t, dt, error estimate, ...)
   Real h = 0.04, h_wall = 0;  // h_wall > 0: graded towards the outer wall, h(x) = min(h, h_wall + 0.25 (R2 - |x|))
   int kmax = 4, kref = -1;
   Real dt0 = 0.05, T = 0.8, dt = 0.002;
@@ -145,7 +148,7 @@ void simulate_with(const Mesh<2>& mesh, const Scene& sc, Real dt, int n, Lineari
 // obs(flow, summary) at T.
 template <class Pair, class Scheme, class Obs>
 void simulate_adaptive(const Mesh<2>& mesh, const Scene& sc, Real tol, Real dt_first, Real T, Linearisation lin,
-                       Obs&& obs) {
+                       const std::filesystem::path& output, Obs&& obs) {
   FlowOptions fo{sc.rho, sc.mu, lin, 25, 1e-10, sc.damped_start};
   fo.start_up = Scheme::theta == 1 ? sc.start_up : StartUp::midpoint;  // MR/AB starts with its own
   fo.tau_dt = dt_first;  // P1/P1-GLS: tau must not change with the steps
@@ -154,7 +157,7 @@ void simulate_adaptive(const Mesh<2>& mesh, const Scene& sc, Real tol, Real dt_f
   an.configure(flow);
   if (sc.wall_moving_at_0 && sc.omega2(0) != 0) an.start_with_moving_wall(flow);
   RunOptions ro;
-  ro.dt = dt_first, ro.t_end = T, ro.tolerance = tol, ro.progress_every = 0, ro.log = nullptr;
+  ro.dt = dt_first, ro.t_end = T, ro.tolerance = tol, ro.progress_every = 0, ro.log = nullptr, ro.output = output;
   ro.velocity_scale = sc.r2;  // the outer wall's final speed (omega_2 -> 1): the flow starts from rest
   const RunSummary sum = run(flow, ro);
   obs(flow, sum);
@@ -393,7 +396,9 @@ int speed_error(const Scene& sc, const Settings& s, const std::vector<Linearisat
           with_types(s.pair, key, [&]<class Pair, class Scheme>() {
             const auto w0 = Clock::now();
             const std::clock_t c0 = std::clock();
-            simulate_adaptive<Pair, Scheme>(mesh, sc, tol, s.dt_first, s.T, lin, [&](const auto& flow, const RunSummary& r) {
+            const std::filesystem::path out =
+                s.output.empty() ? "" : s.output + "/" + key + "_" + (lin == Linearisation::newton ? "newton" : "semi") + "_tol" + fmt("%g", tol);
+            simulate_adaptive<Pair, Scheme>(mesh, sc, tol, s.dt_first, s.T, lin, out, [&](const auto& flow, const RunSummary& r) {
               wall = std::chrono::duration<double>(Clock::now() - w0).count();
               cpu = Real(std::clock() - c0) / CLOCKS_PER_SEC;
               sum = r;
@@ -500,6 +505,7 @@ int main(int argc, char** argv) try {
       .add("lins", lins, "linearisations of the speed study")
       .add("tolerances", s.tolerances, "speed: also adaptive runs (run()) at these error tolerances")
       .add("dt-first", s.dt_first, "speed: the adaptive runs' first step")
+      .add("output", s.output, "speed: folder for each adaptive run's bodies.csv (dt, error estimate per step)")
       .add("csv", s.csv, "CSV file of the results")
       .add("mu", sc.mu, "viscosity")
       .add("rho-s", sc.rho_s, "density of the inner cylinder")

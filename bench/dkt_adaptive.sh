@@ -8,7 +8,8 @@
 # Needs the dkt example built: cmake --preset release && cmake --build --preset release --target dkt
 # usage: bench/dkt_adaptive.sh [OUT_DIR] [LEVEL] [T_END]
 #   defaults: build/release/output/dkt_adaptive  2  0.3
-#   levels (h_body / h_far): 1: 0.04 / 0.3, 2: 0.02 / 0.15, 3: 0.01 / 0.075, 4: 0.005 / 0.0375
+#   levels (h_body / h_far): 1: 0.04 / 0.3, 2: 0.02 / 0.15, 3: 0.01 / 0.075, 4: 0.005 / 0.0375,
+#     5: 0.0025 / 0.01875
 #   environment: DTS (fixed steps, default "2e-3 1e-3 5e-4 2.5e-4"), REF_DT (default 6.25e-5),
 #     TOLS (adaptive tolerances, default "1e-2 3e-3 1e-3 3e-4 1e-4"), FIRST_DT (the adaptive runs'
 #     first step, default 1e-4), OFFSET (cm, default 0.05, as bench/dkt_levels.sh), TAU_DT (the
@@ -28,8 +29,8 @@ offset=${OFFSET:-0.05}
 tau_dt=${TAU_DT:-1e-3}
 build=${BUILD_DIR:-build/release}
 rerun=${RERUN:-1}
-declare -A spec=([1]="0.04 0.3" [2]="0.02 0.15" [3]="0.01 0.075" [4]="0.005 0.0375")
-[[ -n "${spec[$level]:-}" ]] || { echo "unknown level $level (1-4)"; exit 2; }
+declare -A spec=([1]="0.04 0.3" [2]="0.02 0.15" [3]="0.01 0.075" [4]="0.005 0.0375" [5]="0.0025 0.01875")
+[[ -n "${spec[$level]:-}" ]] || { echo "unknown level $level (1-5)"; exit 2; }
 read -r hb hf <<< "${spec[$level]}"
 mkdir -p "$out"
 one() {  # name, extra options

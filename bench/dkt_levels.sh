@@ -8,7 +8,8 @@
 # usage: bench/dkt_levels.sh [OUT_DIR] [T_END] [OFFSETS] [EXECUTABLES] [LEVELS]
 #   defaults: build/release/output/dkt_levels  0.35 (s)  "0.05" (cm)  "dkt dkt_bdf3"  "1 2 3"
 #   levels (h_body / h_far / dt): 1: 0.04 / 0.3 / 2e-3, 2: 0.02 / 0.15 / 1e-3,
-#     3: 0.01 / 0.075 / 5e-4, 4: 0.005 / 0.0375 / 2.5e-4 (about 14 min CPU and 1-1.3 GB per run)
+#     3: 0.01 / 0.075 / 5e-4, 4: 0.005 / 0.0375 / 2.5e-4 (about 8 min CPU and 0.3 GB per run with
+#     the reused factorisations), 5: 0.0025 / 0.01875 / 1.25e-4
 #   OFFSETS: the upper disk's shift to the left; the first is the study, further ones (e.g.
 #     "0.05 0.050001") only change the initial mesh and measure the spread due to the mesh.
 #   environment: BUILD_DIR (default build/release) holds examples/dkt*; SPRING_RANGE (cm,
@@ -23,12 +24,12 @@ levels=${5:-1 2 3}
 build=${BUILD_DIR:-build/release}
 spring=${SPRING_RANGE:-0.04}
 rerun=${RERUN:-1}
-declare -A spec=([1]="0.04 0.3 2e-3" [2]="0.02 0.15 1e-3" [3]="0.01 0.075 5e-4" [4]="0.005 0.0375 2.5e-4")
+declare -A spec=([1]="0.04 0.3 2e-3" [2]="0.02 0.15 1e-3" [3]="0.01 0.075 5e-4" [4]="0.005 0.0375 2.5e-4" [5]="0.0025 0.01875 1.25e-4")
 mkdir -p "$out"
 for exe in $exes; do
   for offset in $offsets; do
     for l in $levels; do
-      [[ -n "${spec[$l]:-}" ]] || { echo "unknown level $l (1-4)"; exit 2; }
+      [[ -n "${spec[$l]:-}" ]] || { echo "unknown level $l (1-5)"; exit 2; }
       read -r hb hf dt <<< "${spec[$l]}"
       dir="$out/${exe}_o${offset}_L$l"
       if [[ "$rerun" == 1 || ! -s "$dir.log" ]] || ! grep -q "^wall" "$dir.log"; then

@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
-"""Seeds for fuzz_checkpoint from a real checkpoint (format version 4).
+"""Seeds for fuzz_checkpoint from a real checkpoint (format version 5).
 
 usage: make_checkpoint_seeds.py CHECKPOINT OUTDIR
 Writes OUTDIR/raw_<name> (mode byte 0, then the file) and OUTDIR/framed_<name> (mode byte 1,
 then the section payloads joined by b"SECT", as the harness frames them), and
 OUTDIR/raw_huge_length (the file with the first section's length field set to 2^60).
 The tree's seeds came from `examples/dkt --h-body 0.12 --h-far 0.6 --t-end 0.003
---checkpoint-every 1 --vtu-every 0 --output OUT` (OUT/checkpoint.bin).
+--checkpoint-every 1 --vtu-every 0 --no-reuse --output OUT` (OUT/checkpoint.bin; without reuse
+the solver sections, which the harness does not read, are empty and the seeds stay small).
 """
 import os
 import struct

@@ -13,7 +13,10 @@
 ///         (DESIGN.md); lambda = 0 keeps it SPD.
 /// The geometry is the one passed to `solve` (the scheme's extrapolated positions), not the
 /// mesh's current coordinates. The sparsity pattern and the symbolic Cholesky analysis are
-/// done once per mesh topology; each solve assembles and factorises numerically. The SPD
+/// done once per mesh topology; each solve assembles, and factorises numerically unless
+/// factorisation reuse is on (`set_reuse`, la/linear_solve.hpp): the matrix then changes
+/// with the positions from step to step only slightly, and is solved by GMRES preconditioned by
+/// the factors of an earlier one (refactorised when that needs too many iterations). The SPD
 /// solver is a policy: by default Eigen's SimplicialLLT in 2D, and in 3D CHOLMOD when alefsi
 /// was built with SuiteSparse, else SimplicialLLT (la/suitesparse.hpp, `DefaultSpdSolverFor<D>`).
 ///
@@ -28,6 +31,7 @@
 #include "alefsi/core/eigen_sparse.hpp"
 #include "alefsi/fem/constraints.hpp"
 #include "alefsi/la/assembler.hpp"
+#include "alefsi/la/linear_solve.hpp"
 #include "alefsi/la/solvers.hpp"
 #include "alefsi/la/suitesparse.hpp"
 #include "alefsi/mesh/mesh.hpp"
@@ -61,6 +65,21 @@ class ElasticMeshMotion {
         cons_);
   }
 
+  /// Factorisation reuse across solves (off by default; ignored by iterative solvers).
+  void set_reuse(const FactorisationReuse& r) { ls_.set_reuse(r); }
+  /// The factorisations and reused solves so far.
+  const LinearSolveCounts& counts() const { return counts_; }
+  /// The solver and its kept matrices (checkpoints), and the matrix of the last solve, whose
+  /// pattern `restore` needs.
+  LinearSolve<Solver>& linear_solve() { return ls_; }
+  const LinearSolve<Solver>& linear_solve() const { return ls_; }
+  /// The matrix with the elasticity pattern (values of the last solve; the pattern alone
+  /// before the first).
+  SparseMatrix& matrix() {
+    if (J_.nonZeros() == 0) asmb_->take_pattern(J_);
+    return J_;
+  }
+
   /// Nodes whose mesh velocity is prescribed (every boundary node).
   const std::vector<Index>& boundary_nodes() const { return boundary_; }
 
@@ -79,17 +98,15 @@ class ElasticMeshMotion {
     const VecX field0 = cons_.expand(VecX::Zero(cons_.n_unknowns()));
     VecX r;
     asmb_->assemble(k, field0, &J_, &r);
-    if (!analysed_) {
-      llt_.analyze(J_);
-      analysed_ = true;
-    }
+    VecX sol;
     try {
-      llt_.factorize(J_);
+      if (!ls_.reusable()) ls_.factorize(J_), ++counts_.factorisations;
+      sol = ls_.solve(J_, VecX(-r), counts_);
     } catch (const SolverError& e) {
       throw SolverError(std::string("mesh-velocity (elasticity) matrix: ") + e.what() +
                         " (is the extrapolated mesh valid?)");
     }
-    const VecX field = cons_.expand(llt_.solve(-r));
+    const VecX field = cons_.expand(sol);
     for (std::size_t v = 0; v < x.size(); ++v)
       for (int kk = 0; kk < D; ++kk) out[v][kk] = field[D * Index(v) + kk];
     return out;
@@ -127,8 +144,8 @@ class ElasticMeshMotion {
   std::vector<Index> boundary_;
   std::unique_ptr<Assembler<n_local>> asmb_;
   SparseMatrix J_;
-  Solver llt_;
-  bool analysed_ = false;
+  LinearSolve<Solver> ls_;
+  LinearSolveCounts counts_;
 };
 
 }  // namespace alefsi

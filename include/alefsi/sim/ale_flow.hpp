@@ -285,12 +285,15 @@ class AleFlow {
     write_config(w);
     write_mesh(w, mesh_);
     write_state(w, state_, bodies_.tags());
-    // the factorisation a reused solve would precondition with (empty: none)
-    const auto& lin = disc_.linear_solve();
-    w.section("solver");
-    w.put_vector(lin.analysed_values());
-    w.put_vector(lin.factored_values());
-    w.put(std::int32_t(lin.refactor_next()));
+    // the factorisations a reused solve would precondition with (empty: none)
+    auto put_solver = [&w](const char* name, const auto& lin) {
+      w.section(name);
+      w.put_vector(lin.analysed_values());
+      w.put_vector(lin.factored_values());
+      w.put(std::int32_t(lin.refactor_next()));
+    };
+    put_solver("solver", disc_.linear_solve());
+    put_solver("mesh-velocity solver", disc_.motion().linear_solve());
     w.commit(true);
   }
   /// Restores what `save_checkpoint` wrote into a flow that has not stepped yet and was built
@@ -306,27 +309,46 @@ class AleFlow {
       r.fail("the flow's mesh is not the checkpoint's (build it with read_checkpoint_mesh)");
     State s = state_;
     read_state(r, s, bodies_.tags(), space().n_field());
-    r.section("solver");
-    const auto analysed = r.get_vector<Real>("analysed matrix");
-    const auto factored = r.get_vector<Real>("factorised matrix");
-    const bool refactor_next = r.get<std::int32_t>("refactorisation flag") != 0;
-    if (analysed.size() != factored.size()) r.fail("the kept matrices differ in size");
+    const KeptFactors flow_factors = read_kept_factors(r, "solver");
+    const KeptFactors motion_factors = read_kept_factors(r, "mesh-velocity solver");
     r.finish();
     s.X[0] = mesh_.coordinates();
     state_ = std::move(s);
     setup();
-    if (!factored.empty()) {
-      SparseMatrix& J = disc_.jacobian();
-      disc_.assembler().take_pattern(J);
-      if (std::size_t(J.nonZeros()) != factored.size())
-        throw IoError("checkpoint '" + file.string() + "': the kept matrices have " + std::to_string(factored.size()) +
-                      " entries, the flow's pattern " + std::to_string(J.nonZeros()));
-      disc_.linear_solve().restore(J, Eigen::Map<const VecX>(analysed.data(), Index(analysed.size())),
-                                   Eigen::Map<const VecX>(factored.data(), Index(factored.size())), refactor_next);
-    }
+    if (!flow_factors.factored.empty()) disc_.assembler().take_pattern(disc_.jacobian());
+    restore_factors(file, "flow", flow_factors, disc_.jacobian(), disc_.linear_solve());
+    restore_factors(file, "mesh-velocity", motion_factors, disc_.motion().matrix(), disc_.motion().linear_solve());
   }
 
  private:
+  // The matrices a solver analysed and factorised last, as a checkpoint keeps them.
+  struct KeptFactors {
+    std::vector<Real> analysed, factored;
+    bool refactor_next = false;
+  };
+  static KeptFactors read_kept_factors(CheckpointReader& r, const char* section) {
+    r.section(section);
+    KeptFactors k;
+    k.analysed = r.get_vector<Real>("analysed matrix");
+    k.factored = r.get_vector<Real>("factorised matrix");
+    k.refactor_next = r.get<std::int32_t>("refactorisation flag") != 0;
+    if (k.analysed.size() != k.factored.size()) r.fail(std::string(section) + ": the kept matrices differ in size");
+    return k;
+  }
+  // Analyses and factorises the kept matrices in `lin` (nothing when none were kept); `J` has
+  // the solver's pattern.
+  template <class Lin>
+  static void restore_factors(const std::filesystem::path& file, const char* what, const KeptFactors& k, SparseMatrix& J,
+                              Lin& lin) {
+    if (k.factored.empty()) return;
+    if (std::size_t(J.nonZeros()) != k.factored.size())
+      throw IoError("checkpoint '" + file.string() + "': the kept " + what + " matrices have " +
+                    std::to_string(k.factored.size()) + " entries, the " + what + " pattern " +
+                    std::to_string(J.nonZeros()));
+    lin.restore(J, Eigen::Map<const VecX>(k.analysed.data(), Index(k.analysed.size())),
+                Eigen::Map<const VecX>(k.factored.data(), Index(k.factored.size())), k.refactor_next);
+  }
+
   // The configuration a checkpoint was written with, checked on reading (what differs named).
   void write_config(CheckpointWriter& w) const {
     w.section("config");

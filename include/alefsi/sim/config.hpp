@@ -120,7 +120,8 @@ struct FlowOptions {
   /// Factorisation reuse (direct solvers; sim/newton.hpp, FactorisationReuse): a step's linear
   /// solve is GMRES preconditioned by the factors of an earlier matrix, to a relative residual
   /// of 1e-13, and the matrix is factorised afresh when that takes more than 16 iterations (the
-  /// next one when it took more than 8) and after every remesh. The choice is automatic;
+  /// next one when it took more than 8) and after every remesh; the mesh-velocity (elasticity)
+  /// solve likewise (physics/mesh_motion.hpp). The choice is automatic;
   /// false: every solve factorises (the results differ at the 1e-13 level). Checkpoints keep the
   /// factorised matrix, so a continued run is bit for bit the uninterrupted one either way.
   bool reuse_factorisation = true;

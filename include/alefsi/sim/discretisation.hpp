@@ -67,6 +67,7 @@ class Discretisation {
     space_ = std::make_unique<Space>(mesh);
     kernel_ = std::make_unique<Kernel>(*space_, opt_.rho, opt_.mu, opt_.linearisation);
     motion_ = std::make_unique<Motion>(mesh);
+    motion_->set_reuse({.enabled = opt_.reuse_factorisation});
     cons_.reset();
     asmb_.reset();
     J_ = SparseMatrix();  // the assembler keeps a matrix whose size matches: a flip keeps the size
@@ -126,6 +127,7 @@ class Discretisation {
   const Space& space() const { return *space_; }
   Kernel& kernel() { return *kernel_; }
   Motion& motion() { return *motion_; }
+  const Motion& motion() const { return *motion_; }
   DofConstraints& constraints() { return *cons_; }
   const DofConstraints& constraints() const { return *cons_; }
   const FlowAssembler& assembler() const { return *asmb_; }

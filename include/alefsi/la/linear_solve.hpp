@@ -1,0 +1,140 @@
+#pragma once
+/// \file la/linear_solve.hpp
+/// A linear solver policy (la/solvers.hpp) with the state of its symbolic analysis and, for
+/// direct solvers, the reuse of a factorisation across solves of slowly changing matrices
+/// (Newton iterations, time steps): `LinearSolve::solve(J, r, counts)` factorises J, or solves
+/// it by GMRES (la/gmres.hpp) preconditioned by the factors of an earlier matrix. The flow's
+/// Newton solve (sim/newton.hpp) and the mesh-velocity problem (physics/mesh_motion.hpp) use it.
+///
+///     LinearSolve<SparseLu<>> lin;
+///     lin.set_reuse({.enabled = true});
+///     if (!lin.reusable()) lin.factorize(J);
+///     VecX x = lin.solve(J, r, counts);
+#include <utility>
+
+#include "alefsi/core/eigen_sparse.hpp"
+#include "alefsi/core/error.hpp"
+#include "alefsi/la/gmres.hpp"
+#include "alefsi/la/solvers.hpp"
+
+namespace alefsi {
+
+/// Reuse of a factorisation across Newton iterations and time steps (direct solvers only): the
+/// matrix of a later solve is solved by GMRES (la/gmres.hpp) preconditioned by the factors of
+/// an earlier matrix, and factorised afresh when that needs more than `max_iterations`
+/// (or, at the next solve, when it needed more than `refactor_above`), or after the pattern
+/// changed (a remesh). Measured: docs/performance.md ("Factorisations reused").
+struct FactorisationReuse {
+  bool enabled = false;
+  int max_iterations = 16;  ///< GMRES iterations of a reused solve before J is factorised
+  int refactor_above = 8;   ///< a reused solve that needed more: the next one factorises
+  Real tolerance = 1e-13;   ///< relative residual ||J x - r|| / ||r|| of a reused solve
+};
+
+/// What the linear solves did (per Newton solve; StepReport sums them per step).
+struct LinearSolveCounts {
+  int factorisations = 0;     ///< numeric factorisations
+  int reused = 0;             ///< solves by GMRES on an earlier factorisation
+  int krylov_iterations = 0;  ///< their GMRES iterations
+  LinearSolveCounts& operator+=(const LinearSolveCounts& o) {
+    factorisations += o.factorisations, reused += o.reused, krylov_iterations += o.krylov_iterations;
+    return *this;
+  }
+};
+
+
+/// A linear solver policy (constructed in place: solvers such as SparseLu cannot be moved), the
+/// state of its symbolic analysis and, with reuse on, of its factorisation: the values of the
+/// matrices it analysed and factorised are kept, so that a checkpoint can restore the same
+/// factors (`restore`).
+template <LinearSolver S>
+class LinearSolve {
+ public:
+  template <class... Args>
+  explicit LinearSolve(Args&&... args) : solver_(std::forward<Args>(args)...) {}
+  /// Reuse on or off (always off for iterative solvers).
+  void set_reuse(const FactorisationReuse& r) {
+    reuse_ = r;
+    if constexpr (!DirectSolver<S>) reuse_.enabled = false;
+    if (!reuse_.enabled) factored_ = false;
+  }
+  const FactorisationReuse& reuse() const { return reuse_; }
+  /// The sparsity pattern changed: analyse again before the next factorisation.
+  void reset() {
+    analysed_ = false;
+    factored_ = false;
+    analysed_values_.resize(0), factored_values_.resize(0);
+  }
+  void factorize(const SparseMatrix& J) {
+    if (!analysed_) {
+      solver_.analyze(J);
+      analysed_ = true;
+      if (reuse_.enabled) analysed_values_ = values(J);
+    }
+    solver_.factorize(J);
+    factored_ = reuse_.enabled, fresh_ = true, refactor_next_ = false;
+    if (reuse_.enabled) factored_values_ = values(J);
+  }
+  /// The next solve of a new matrix can use the factors at hand (no factorisation first).
+  bool reusable() const { return reuse_.enabled && factored_ && !refactor_next_; }
+  VecX solve(const VecX& r) { return solver_.solve(r); }
+  /// Solves J x = r: directly after factorize(J); otherwise by GMRES preconditioned by the
+  /// factors at hand, and, when that misses its tolerance in max_iterations, by factorising J.
+  VecX solve(const SparseMatrix& J, const VecX& r, LinearSolveCounts& counts) {
+    if (fresh_ || !reusable()) {
+      if (!fresh_) factorize(J), ++counts.factorisations;
+      fresh_ = false;
+      return solver_.solve(r);
+    }
+    VecX x;
+    const GmresResult res = gmres(
+        J, r, [this](const VecX& v) { return VecX(solver_.solve(v)); },
+        {.tolerance = reuse_.tolerance, .max_iterations = reuse_.max_iterations, .restart = reuse_.max_iterations}, x,
+        work_);
+    counts.krylov_iterations += res.iterations;
+    if (res.converged) {
+      ++counts.reused;
+      refactor_next_ = res.iterations > reuse_.refactor_above;
+      return x;
+    }
+    factorize(J);
+    ++counts.factorisations;
+    fresh_ = false;
+    return solver_.solve(r);
+  }
+  /// The values of the matrices analysed and factorised last (empty: none, or reuse off), and
+  /// whether the next solve factorises: what a checkpoint keeps.
+  const VecX& analysed_values() const { return analysed_values_; }
+  const VecX& factored_values() const { return factored_values_; }
+  bool refactor_next() const { return refactor_next_; }
+  /// Analyses and factorises the matrices with the pattern of `J` and these values, as
+  /// `factorize` did when they were kept; `J`'s values are overwritten.
+  void restore(SparseMatrix& J, const VecX& analysed, const VecX& factored, bool refactor_next) {
+    reset();
+    if (factored.size() == 0) return;
+    ALEFSI_CHECK_ARG(analysed.size() == J.nonZeros() && factored.size() == J.nonZeros(), "restore",
+                     "the kept matrices have ", factored.size(), " entries, the pattern ", J.nonZeros());
+    Eigen::Map<VecX>(J.valuePtr(), J.nonZeros()) = analysed;
+    solver_.analyze(J);
+    analysed_ = true, analysed_values_ = analysed;
+    Eigen::Map<VecX>(J.valuePtr(), J.nonZeros()) = factored;
+    factorize(J);
+    fresh_ = false, refactor_next_ = refactor_next;
+  }
+  S& solver() { return solver_; }
+  const S& solver() const { return solver_; }
+
+ private:
+  static VecX values(const SparseMatrix& J) { return Eigen::Map<const VecX>(J.valuePtr(), J.nonZeros()); }
+
+  S solver_;
+  bool analysed_ = false;
+  FactorisationReuse reuse_;
+  bool factored_ = false;       // reuse on and factors at hand
+  bool fresh_ = false;          // the factors are the matrix's of the coming solve
+  bool refactor_next_ = false;  // the last reused solve needed many iterations
+  VecX analysed_values_, factored_values_;
+  GmresWork work_;
+};
+
+}  // namespace alefsi

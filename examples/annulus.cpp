@@ -122,12 +122,17 @@ Mesh<2> make_mesh(const Scene& sc, const Settings& s) { return sc.annulus().mesh
 
 // --- one FEM run -------------------------------------------------------------------------------
 // Advances n steps of dt and calls obs(flow, step, report) after each; rigid inner body, driven outer wall.
+// The flow options of a run of Scheme.
+template <class Scheme>
+FlowOptions flow_options(const Scene& sc, Linearisation lin) {
+  FlowOptions fo{sc.rho, sc.mu, lin, 25, 1e-10, sc.damped_start};
+  fo.start_up = Scheme::theta == 1 ? sc.start_up : StartUp::midpoint;  // MR/AB starts with its own
+  return fo;
+}
 template <class Pair, class Scheme, bool Convection, class Obs>
 void simulate_with(const Mesh<2>& mesh, const Scene& sc, Real dt, int n, Linearisation lin, Obs&& obs) {
   using Equations = std::conditional_t<Convection, NavierStokes, UnsteadyStokes>;
-  FlowOptions fo{sc.rho, sc.mu, lin, 25, 1e-10, sc.damped_start};
-  fo.start_up = Scheme::theta == 1 ? sc.start_up : StartUp::midpoint;  // MR/AB starts with its own
-  AleFlow<FlowConfig<2, Pair, Scheme, Equations, Solver>> flow(mesh, fo);
+  AleFlow<FlowConfig<2, Pair, Scheme, Equations, Solver>> flow(mesh, flow_options<Scheme>(sc, lin));
   const scenes::Annulus an = sc.annulus();
   an.configure(flow);
   if (sc.wall_moving_at_0 && sc.omega2(0) != 0) an.start_with_moving_wall(flow);
@@ -149,8 +154,7 @@ void simulate_with(const Mesh<2>& mesh, const Scene& sc, Real dt, int n, Lineari
 template <class Pair, class Scheme, class Obs>
 void simulate_adaptive(const Mesh<2>& mesh, const Scene& sc, Real tol, Real dt_first, Real T, Linearisation lin,
                        const std::filesystem::path& output, Obs&& obs) {
-  FlowOptions fo{sc.rho, sc.mu, lin, 25, 1e-10, sc.damped_start};
-  fo.start_up = Scheme::theta == 1 ? sc.start_up : StartUp::midpoint;  // MR/AB starts with its own
+  FlowOptions fo = flow_options<Scheme>(sc, lin);
   fo.tau_dt = dt_first;  // P1/P1-GLS: tau must not change with the steps
   AleFlow<FlowConfig<2, Pair, Scheme, NavierStokes, Solver>> flow(mesh, fo);
   const scenes::Annulus an = sc.annulus();
@@ -390,6 +394,7 @@ int speed_error(const Scene& sc, const Settings& s, const std::vector<Linearisat
     for (const auto& key : s.schemes)
       for (Real tol : s.tolerances) {
         if (key == "MR_AB") continue;
+        const char* ln = lin == Linearisation::newton ? "newton" : "semi";
         Real efd = NAN, et = NAN, ew = NAN, wall = 0, cpu = 0;
         RunSummary sum;
         try {
@@ -397,7 +402,7 @@ int speed_error(const Scene& sc, const Settings& s, const std::vector<Linearisat
             const auto w0 = Clock::now();
             const std::clock_t c0 = std::clock();
             const std::filesystem::path out =
-                s.output.empty() ? "" : s.output + "/" + key + "_" + (lin == Linearisation::newton ? "newton" : "semi") + "_tol" + fmt("%g", tol);
+                s.output.empty() ? "" : s.output + "/" + key + "_" + ln + "_tol" + fmt("%g", tol);
             simulate_adaptive<Pair, Scheme>(mesh, sc, tol, s.dt_first, s.T, lin, out, [&](const auto& flow, const RunSummary& r) {
               wall = std::chrono::duration<double>(Clock::now() - w0).count();
               cpu = Real(std::clock() - c0) / CLOCKS_PER_SEC;
@@ -410,7 +415,6 @@ int speed_error(const Scene& sc, const Settings& s, const std::vector<Linearisat
           std::printf("| %s | tol %g | failed: %s |\n", display_name(key), tol, e.what());
           continue;
         }
-        const char* ln = lin == Linearisation::newton ? "newton" : "semi";
         std::printf("| %s | %s | %.0e | %d (%d) | %.1e .. %.1e | %.4e | %.4e | %.2f | %.2f |\n", display_name(key), ln, tol,
                     sum.steps, sum.rejected, sum.dt_smallest, sum.dt_largest, efd, et, wall, cpu);
         if (csv.is_open())

@@ -31,7 +31,8 @@ struct FactorisationReuse {
   Real tolerance = 1e-13;   ///< relative residual ||J x - r|| / ||r|| of a reused solve
 };
 
-/// What the linear solves did (per Newton solve; StepReport sums them per step).
+/// What the linear solves did (a Newton solve's, summed per step in StepReport; a mesh-velocity
+/// solver's since it was built).
 struct LinearSolveCounts {
   int factorisations = 0;     ///< numeric factorisations
   int reused = 0;             ///< solves by GMRES on an earlier factorisation
@@ -41,7 +42,6 @@ struct LinearSolveCounts {
     return *this;
   }
 };
-
 
 /// A linear solver policy (constructed in place: solvers such as SparseLu cannot be moved), the
 /// state of its symbolic analysis and, with reuse on, of its factorisation: the values of the

@@ -100,8 +100,7 @@ class ElasticMeshMotion {
     asmb_->assemble(k, field0, &J_, &r);
     VecX sol;
     try {
-      if (!ls_.reusable()) ls_.factorize(J_), ++counts_.factorisations;
-      sol = ls_.solve(J_, VecX(-r), counts_);
+      sol = ls_.solve(J_, VecX(-r), counts_);  // factorises J_ unless earlier factors are reused
     } catch (const SolverError& e) {
       throw SolverError(std::string("mesh-velocity (elasticity) matrix: ") + e.what() +
                         " (is the extrapolated mesh valid?)");

@@ -105,7 +105,9 @@ class AleFlow {
   /// `solver()` gives access to afterwards.
   template <class... SolverArgs>
   AleFlow(Mesh<D> mesh, FlowOptions opt, SolverArgs&&... solver_args)
-      : mesh_(std::move(mesh)), opt_((opt.validate(), opt)), stepper_(opt.damped_start, opt.variable_steps, opt.start_up),
+      : mesh_(std::move(mesh)),
+        opt_((opt.validate(), opt)),
+        stepper_(opt.damped_start, opt.variable_steps, opt.start_up),
         disc_(mesh_, opt_, std::forward<SolverArgs>(solver_args)...), contact_(DefaultContact<D>::geometry()) {
     state_.X[0] = mesh_.coordinates();
     state_.U[0] = VecX::Zero(disc_.space().n_field());

@@ -30,7 +30,6 @@
 ///     NewtonReport rep = newton_solve([&](const VecX& u, SparseMatrix& J, VecX& r) { ... }, lin, u, {});
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <string>
 #include <utility>

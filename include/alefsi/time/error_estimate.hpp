@@ -67,8 +67,9 @@ struct ErrorControl {
 /// The size of a step's estimated local error (max norms), against the flow's velocity scale.
 /// Velocities are what is controlled: the flow's (the free velocity DOFs: not the pressure, an
 /// algebraic variable, nor prescribed values such as a wall's data, whose extrapolation error
-/// is not the scheme's, nor a body's surface, given by its Z) and the free bodies' Z, a body's angular part weighted by its radius L
-/// (the largest distance of a surface node from its centre), so that it is a surface velocity.
+/// is not the scheme's, nor a body's surface, given by its Z) and the free bodies' Z, a body's
+/// angular part weighted by its radius L (the largest distance of a surface node from its
+/// centre), so that it is a surface velocity.
 /// Positions are their integrals and follow.
 struct ErrorEstimate {
   bool available = false;  ///< false for start-up steps (too few levels)

@@ -84,6 +84,32 @@ TEST_CASE("annulus mesh: nodes on circles, area approaches pi (r2^2 - r1^2)", "[
   CHECK(std::abs(m.total_measure() - exact) < 1e-3);
 }
 
+TEST_CASE("spherical shell mesh: conforming, nodes on the spheres, no cell flat on a sphere", "[mesh][quick]") {
+  const Real r1 = 0.5, r2 = 1.0;
+  for (int n : {1, 2}) {
+    const auto m = spherical_shell_mesh(r1, r2, n, Vec<3>(0.1, 0.2, 0.3));
+    CHECK(m.n_cells() == 336 * n * n * n);
+    // the boundary: two spheres of 48 n^2 and 192 n^2 triangles (each cube face's boxes halved)
+    Index n_in = 0, n_out = 0;
+    for (Index f : m.boundary_facets()) (m.facet_tag(f) == tags::inner ? n_in : n_out) += 1;
+    CHECK(n_in == 48 * n * n);
+    CHECK(n_out == 192 * n * n);
+    for (Index i : m.boundary_nodes(tags::inner)) CHECK((m.node(i) - Vec<3>(0.1, 0.2, 0.3)).norm() == Approx(r1).epsilon(1e-14));
+    for (Index i : m.boundary_nodes(tags::outer)) CHECK((m.node(i) - Vec<3>(0.1, 0.2, 0.3)).norm() == Approx(r2).epsilon(1e-14));
+    // every cell has a vertex off each sphere it touches: none of them is a flat sliver on it
+    Real worst = 1;
+    for (Index c = 0; c < m.n_cells(); ++c) {
+      CHECK(m.signed_measure(c) > 0);
+      worst = std::min(worst, m.quality(c));
+    }
+    CHECK(worst > 0.2);
+    // the polyhedral volume approaches the shell's from below at O(h^2)
+    const Real exact = 4 * std::numbers::pi / 3 * (r2 * r2 * r2 - r1 * r1 * r1);
+    CHECK(m.total_measure() < exact);
+    CHECK(m.total_measure() > (n == 1 ? 0.9 : 0.97) * exact);
+  }
+}
+
 TEST_CASE("cell edges and facets follow the local conventions", "[mesh][quick]") {
   const auto m = box_mesh(1, 1, 1);
   for (Index c = 0; c < m.n_cells(); ++c) {

@@ -29,6 +29,7 @@
 #include "alefsi/core/error.hpp"
 #include "alefsi/fem/constraints.hpp"
 #include "alefsi/fem/dofmap.hpp"
+#include "alefsi/fem/geometry.hpp"
 #include "alefsi/fem/quadrature.hpp"
 #include "alefsi/la/assembler.hpp"
 #include "alefsi/la/solvers.hpp"
@@ -45,6 +46,8 @@ using VectorFunction = std::function<Vec<D>(const Vec<D>&)>;
 /// load (if any) by quadrature of degree 2k + 2; the stabilisation's block of A and its part
 /// of F from the pair's policy `Stabilisation` (PSPG for P1/P1-GLS). r = A u - F. Equal to
 /// the quadrature oracle (tests/support/oracle_kernels.hpp) to round-off.
+/// With a `QuadraticGeometry` (P2 velocity pairs), curved cells are integrated by the same
+/// rule of degree 2k + 2 through the isoparametric map (`curved_cell`), straight ones as above.
 /// `cell` is const and touches only its arguments: safe to call from several threads (the
 /// force function must then be too).
 template <int D, ElementPair Pair>
@@ -70,7 +73,23 @@ class StokesKernel {
   /// Stabilisation parameter tau_K of cell c (0 for stable pairs).
   Real tau(Index c) const { return stab_.tau(space_->mesh(), c); }
 
+  /// Integrates the curved cells of `g` through their quadratic map (null: every cell affine).
+  /// The geometry must be on this kernel's mesh and outlive the kernel.
+  void set_geometry(const QuadraticGeometry<D>* g)
+    requires(V::degree == 2)
+  {
+    ALEFSI_CHECK_ARG(!g || &g->mesh() == &space_->mesh(), "geometry", "is on another mesh than the space's");
+    geom_ = g;
+    if (g && geo_dN_.empty())
+      for (int q = 0; q < tab_.rule->size(); ++q) {
+        geo_N_.push_back(QuadraticGeometry<D>::Shape::values(tab_.rule->points[q]));
+        geo_dN_.push_back(QuadraticGeometry<D>::Shape::gradients(tab_.rule->points[q]));
+      }
+  }
+  const QuadraticGeometry<D>* geometry() const { return geom_; }
+
   void cell(Index c, const LocalVec& u, LocalMat& A, LocalVec& r) const {
+    if (geom_ && geom_->curved(c)) return curved_cell(c, u, A, r);
     const Mat<D> J = space_->mesh().jacobian(c);
     const Mat<D> Jinv = J.inverse();
     const Real detJ = J.determinant();
@@ -100,6 +119,48 @@ class StokesKernel {
     return F;
   }
 
+  /// Cell c through the isoparametric map x(xi) = sum_k N_k(xi) X_k: at each point of the
+  /// rule, J(xi), physical gradients dphi J^-1 and weights w det J(xi);
+  ///   A(D a + i, D b + j) += w mu (g_a . g_b delta_ij + g_a,j g_b,i)   (2 mu (D(u), D(v)))
+  ///   A(D a + i, D nv + b) = A(D nv + b, D a + i) -= w psi_b g_a,i    (-(p, div v) - (q, div u))
+  /// and the load w f(x(xi)) phi_a. Equal to the affine path when the edge points are the
+  /// midpoints (tested).
+  void curved_cell(Index c, const LocalVec& u, LocalMat& A, LocalVec& r) const {
+    using Geometry = QuadraticGeometry<D>;
+    const auto X = geom_->cell_nodes(c);
+    const auto& rule = *tab_.rule;
+    A.setZero();
+    LocalVec F = LocalVec::Zero();
+    for (int q = 0; q < rule.size(); ++q) {
+      const Mat<D> J = Geometry::jacobian(X, geo_dN_[std::size_t(q)]);
+      const Real w = rule.weights[q] * J.determinant();
+      const Eigen::Matrix<Real, nv, D> g = tab_.dphi_v[q] * J.inverse();
+      const Eigen::Matrix<Real, nv, nv> gg = (w * mu_) * (g * g.transpose());
+      for (int a = 0; a < nv; ++a)
+        for (int b = 0; b < nv; ++b)
+          for (int i = 0; i < D; ++i) {
+            A(D * a + i, D * b + i) += gg(a, b);
+            for (int j = 0; j < D; ++j) A(D * a + i, D * b + j) += w * mu_ * g(a, j) * g(b, i);
+          }
+      const auto& psi = tab_.phi_p[q];
+      for (int a = 0; a < nv; ++a)
+        for (int i = 0; i < D; ++i)
+          for (int b = 0; b < np; ++b) {
+            const Real v = w * psi[b] * g(a, i);
+            A(D * a + i, D * nv + b) -= v;
+            A(D * nv + b, D * a + i) -= v;
+          }
+      if (f_) {
+        const Vec<D> fq = f_(Geometry::map(X, geo_N_[std::size_t(q)]));
+        const auto& phv = tab_.phi_v[q];
+        for (int a = 0; a < nv; ++a)
+          for (int i = 0; i < D; ++i) F[D * a + i] += w * fq[i] * phv[a];
+      }
+    }
+    r.noalias() = A * u;
+    if (f_) r -= F;
+  }
+
  private:
   const Space* space_;
   Real mu_;
@@ -107,26 +168,37 @@ class StokesKernel {
   const Forms* forms_;
   [[no_unique_address]] Stabilisation stab_;  // empty without stabilisation
   ReferenceTables<D, Pair> tab_;
+  const QuadraticGeometry<D>* geom_ = nullptr;
+  std::vector<typename QuadraticGeometry<D>::Shape::Values> geo_N_;        // geometry shape values at tab_'s points
+  std::vector<typename QuadraticGeometry<D>::Shape::Gradients> geo_dN_;   // ... and their reference gradients
 };
 
 /// Adds a constant to the pressure part of `field` so that the pressure has zero mean over
-/// the domain (the pressure of a flow with every boundary velocity prescribed).
+/// the domain (the pressure of a flow with every boundary velocity prescribed); over the
+/// curved cells of `geometry` if given.
 template <int D, ElementPair Pair>
-void shift_pressure_to_zero_mean(const MixedSpace<D, Pair>& space, VecX& field) {
+void shift_pressure_to_zero_mean(const MixedSpace<D, Pair>& space, VecX& field,
+                                 const QuadraticGeometry<D>* geometry = nullptr) {
   using P = typename Pair::template Pressure<D>;
+  using Geometry = QuadraticGeometry<D>;
   const auto& mesh = space.mesh();
-  const auto& rule = simplex_quadrature<D>(P::degree);
+  const auto& rule = simplex_quadrature<D>(geometry ? P::degree + 2 : P::degree);
   Real integral = 0, volume = 0;
   for (Index c = 0; c < mesh.n_cells(); ++c) {
+    const bool curved = geometry && geometry->curved(c);
     const Real m = mesh.measure(c) / reference_measure<D>;
+    const auto X = curved ? geometry->cell_nodes(c) : typename Geometry::Nodes{};
     const auto& dofs = space.pressure().cell_dofs(c);
     for (int q = 0; q < rule.size(); ++q) {
       const auto phi = P::values(rule.points[q]);
       Real p = 0;
       for (int b = 0; b < P::n_dofs; ++b) p += phi[b] * field[space.pressure_field(dofs[b])];
-      integral += rule.weights[q] * m * p;
+      const Real w =
+          rule.weights[q] *
+          (curved ? Geometry::jacobian(X, Geometry::Shape::gradients(rule.points[q])).determinant() : m);
+      integral += w * p;
+      volume += w;
     }
-    volume += mesh.measure(c);
   }
   const Real mean = integral / volume;
   for (Index k = 0; k < space.pressure().n_dofs(); ++k) field[space.pressure_field(k)] -= mean;
@@ -171,6 +243,16 @@ class Stokes {
   Stokes(const Mesh<D>& mesh, Real mu, VectorFunction<D> force = {})
       : space_(mesh), kernel_(space_, mu, std::move(force)) {}
 
+  /// Isoparametric P2 (Taylor–Hood): the curved cells of `g` are integrated through their
+  /// quadratic map and the boundary values are taken at the edge points. `g` must be on this
+  /// problem's mesh and outlive it.
+  void set_geometry(const QuadraticGeometry<D>& g)
+    requires(Space::VelocityElement::degree == 2)
+  {
+    kernel_.set_geometry(&g);
+    geom_ = &g;
+  }
+
   /// Prescribes the velocity on the boundary facets with tag `tag`.
   void set_velocity(int tag, VectorFunction<D> g) {
     ALEFSI_CHECK_ARG(g != nullptr, "g", "boundary velocity function is empty");
@@ -190,7 +272,7 @@ class Stokes {
     const auto& vel = space_.velocity();
     std::vector<char> taken(vel.n_dofs(), 0);
     for (const auto& [i, tag] : fix_velocity_on_tags(space_, dirichlet_, cons, taken)) {
-      const Vec<D> val = dirichlet_.at(tag)(vel.point(i));
+      const Vec<D> val = dirichlet_.at(tag)(geom_ ? geom_->dof_point(i) : vel.point(i));
       for (int k = 0; k < D; ++k) cons.set_fixed_value(space_.velocity_field(i, k), val[k]);
     }
     pinned_ = whole_boundary_prescribed(space_.mesh(), [&](int tag) { return dirichlet_.count(tag) > 0; });
@@ -210,12 +292,15 @@ class Stokes {
   }
 
   /// Adds a constant to the pressure so that its mean over the domain is zero.
-  void shift_pressure_to_zero_mean(VecX& field) const { alefsi::shift_pressure_to_zero_mean(space_, field); }
+  void shift_pressure_to_zero_mean(VecX& field) const { alefsi::shift_pressure_to_zero_mean(space_, field, geom_); }
+  /// The geometry set by `set_geometry` (null: affine cells).
+  const QuadraticGeometry<D>* geometry() const { return geom_; }
 
  private:
   Space space_;
   Kernel kernel_;
   std::map<int, VectorFunction<D>> dirichlet_;
+  const QuadraticGeometry<D>* geom_ = nullptr;
   bool pinned_ = false;
 };
 

@@ -5,13 +5,16 @@
 /// Boundary tags (constants in `alefsi::tags`):
 ///   rectangle: bottom = 1 (y = y0), right = 2 (x = x1), top = 3 (y = y1), left = 4 (x = x0)
 ///   box:       xmin = 1, xmax = 2, ymin = 3, ymax = 4, zmin = 5, zmax = 6
-///   annulus:   inner = 1, outer = 2
+///   annulus, spherical shell:   inner = 1, outer = 2
 ///
 ///     auto sq = alefsi::rectangle_mesh(16, 16);                   // [0,1]^2, 512 triangles
 ///     auto cube = alefsi::box_mesh(4, 4, 4);                      // [0,1]^3, 384 tetrahedra
 ///     auto ring = alefsi::annulus_mesh(0.25, 1.0, 8, 64);         // radii 0.25 and 1
+///     auto shell = alefsi::spherical_shell_mesh(0.5, 1.0, 2);     // 2 layers, 2,688 tetrahedra
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <vector>
 
@@ -148,6 +151,91 @@ inline Mesh<2> annulus_mesh(Real r1, Real r2, int nr, int nt, const Vec<2>& cent
     bf.push_back({id(i, nr), id(i + 1, nr)}), bt.push_back(tags::outer);
   }
   return Mesh<2>(std::move(x), std::move(cells), bf, bt);
+}
+
+/// The spherical shell r1 < |x - centre| < r2 with n layers of cells across the gap: the cube
+/// [-1, 1]^3 cut into (4n)^3 boxes, the central (2n)^3 (the cube [-1/2, 1/2]^3) removed, the
+/// rest split into six tetrahedra around a diagonal (336 n^3 tetrahedra), then mapped onto the
+/// shell by the equiangular cubed-sphere map: on the face |p_k| = s = |p|_inf of a cube shell
+/// the other two coordinates go to s tan(pi/4 p_j / s) (equal angles along the face), and the
+/// point to radius r1 + (r2 - r1) (2 s - 1) along that direction. The split is box_mesh's
+/// mirrored into each octant (every box's diagonal points at the centre, conforming across the
+/// mirror planes), so that no tetrahedron has its four vertices on one sphere (the corner and
+/// edge boxes of a cube shell would otherwise give flat slivers on the sphere). Nodes on both
+/// spheres lie exactly on them; sizes vary by about 1.4 between face centres and corners.
+inline Mesh<3> spherical_shell_mesh(Real r1, Real r2, int n, const Vec<3>& centre = Vec<3>::Zero()) {
+  ALEFSI_CHECK_ARG(r1 > 0 && std::isfinite(r1), "r1", "must be positive and finite, got ", r1);
+  ALEFSI_CHECK_ARG(r2 > r1 && std::isfinite(r2), "r2", "must be finite and exceed r1, got ", r2);
+  ALEFSI_CHECK_ARG(n >= 1, "n", "must be >= 1, got ", n);
+  const int m = 4 * n;
+  auto grid = [&](const std::array<int, 3>& q) { return std::size_t((q[2] * (m + 1) + q[1]) * (m + 1) + q[0]); };
+  auto removed = [&](int i, int j, int k) {  // box (i, j, k) inside the inner cube
+    return i >= n && i < 3 * n && j >= n && j < 3 * n && k >= n && k < 3 * n;
+  };
+  // nodes: every grid point not strictly inside the inner cube, mapped onto the shell
+  std::vector<Index> id(std::size_t(m + 1) * (m + 1) * (m + 1), -1);
+  std::vector<Vec<3>> x;
+  std::vector<char> on_sphere;  // 1 inner, 2 outer, 0 neither
+  for (int k = 0; k <= m; ++k)
+    for (int j = 0; j <= m; ++j)
+      for (int i = 0; i <= m; ++i) {
+        if (i > n && i < 3 * n && j > n && j < 3 * n && k > n && k < 3 * n) continue;
+        Vec<3> p(Real(2 * i - m) / m, Real(2 * j - m) / m, Real(2 * k - m) / m);
+        const Real s = p.cwiseAbs().maxCoeff();
+        for (int d = 0; d < 3; ++d)
+          if (std::abs(p[d]) < s) p[d] = s * std::tan(std::numbers::pi / 4 * p[d] / s);
+        id[grid({i, j, k})] = Index(x.size());
+        x.push_back(centre + (r1 + (r2 - r1) * (2 * s - 1)) * p.normalized());
+        const int is = std::max({std::abs(2 * i - m), std::abs(2 * j - m), std::abs(2 * k - m)});
+        on_sphere.push_back(is == m ? 2 : is == m / 2 ? 1 : 0);
+      }
+  // cells: six tetrahedra per box along monotone paths from the box's outer corner to its inner one
+  static constexpr std::array<std::array<int, 3>, 6> perms{
+      {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}}};
+  std::vector<Mesh<3>::Cell> cells;
+  cells.reserve(std::size_t(336) * n * n * n);
+  for (int k = 0; k < m; ++k)
+    for (int j = 0; j < m; ++j)
+      for (int i = 0; i < m; ++i) {
+        if (removed(i, j, k)) continue;
+        const std::array<int, 3> box{i, j, k};
+        std::array<int, 3> start{}, step{};
+        for (int d = 0; d < 3; ++d) {
+          const bool upper = 2 * box[d] >= m;  // the diagonal runs towards the centre
+          start[d] = upper ? box[d] + 1 : box[d];
+          step[d] = upper ? -1 : 1;
+        }
+        for (const auto& perm : perms) {
+          std::array<int, 3> q = start;
+          Mesh<3>::Cell c;
+          c[0] = id[grid(q)];
+          for (int t = 0; t < 3; ++t) {
+            q[perm[t]] += step[perm[t]];
+            c[t + 1] = id[grid(q)];
+          }
+          const Mat<3> J = (Mat<3>() << x[std::size_t(c[1])] - x[std::size_t(c[0])],
+                            x[std::size_t(c[2])] - x[std::size_t(c[0])], x[std::size_t(c[3])] - x[std::size_t(c[0])])
+                               .finished();
+          if (J.determinant() < 0) std::swap(c[1], c[2]);
+          cells.push_back(c);
+        }
+      }
+  // boundary: the facets of one cell only; on the inner or the outer sphere
+  std::map<std::array<Index, 3>, int> count;
+  for (const auto& c : cells)
+    for (const auto& lf : SimplexTopology<3>::facets) {
+      std::array<Index, 3> f{c[lf[0]], c[lf[1]], c[lf[2]]};
+      std::sort(f.begin(), f.end());
+      ++count[f];
+    }
+  std::vector<Mesh<3>::Facet> bf;
+  std::vector<int> bt;
+  for (const auto& [f, k] : count) {
+    if (k != 1) continue;
+    bf.push_back({f[0], f[1], f[2]});
+    bt.push_back(on_sphere[std::size_t(f[0])] == 1 ? tags::inner : tags::outer);
+  }
+  return Mesh<3>(std::move(x), std::move(cells), bf, bt);
 }
 
 }  // namespace alefsi

@@ -148,7 +148,7 @@ TEST_CASE("quadratic geometry: the shell's volume error drops from O(h^2) to O(h
   // O(h^3) at least (in 2D the arc's interpolation error is odd about the edge's midpoint and
   // cancels to O(h^5) per edge, hence h^4). On the structured shells (1..4 layers, h ~ 1/n)
   // symmetric pairs of faces cancel too and the order is 4; on gmsh's unstructured shells it is
-  // 2.85 and 2.90 (h = 0.35, 0.25, 0.18, orders from the cell counts).
+  // 2.86 and 2.90 (h = 0.35, 0.25, 0.18, orders from the cell counts).
   const Real exact = 4 * pi / 3 * (b * b * b - a * a * a);
   Real es[4], ec[4];
   for (int k = 0; k < 4; ++k) {
@@ -165,13 +165,26 @@ TEST_CASE("quadratic geometry: the shell's volume error drops from O(h^2) to O(h
   std::cout << "  orders (3 -> 4 layers): straight " << rs << ", curved " << rc << "\n";
   CHECK(rs == Approx(2).margin(0.1));
   CHECK(rc > 2.9);  // measured 3.98
-  // and on gmsh's unstructured shell (h = 0.18): the same gap
-  const auto mesh = shell_mesh("018");
-  QuadraticGeometry<3> g(mesh);
-  const Real e_straight = std::abs(measure(g) / exact - 1);
-  project_boundary_edges(g, 1, onto_sphere<3>(Vec<3>::Zero(), a));
-  project_boundary_edges(g, 2, onto_sphere<3>(Vec<3>::Zero(), b));
-  CHECK(std::abs(measure(g) / exact - 1) < 0.01 * e_straight);  // measured 1.6e-5 against 6.5e-3
+  // and on gmsh's unstructured shells (h = 0.35, 0.25, 0.18): the same gap; the orders (from
+  // the cell counts) are noisy on such meshes and only printed (measured: straight 2.06, 2.81;
+  // curved 2.86, 2.90)
+  Real gs[3], gc[3], n[3];
+  int k = 0;
+  for (const char* name : {"035", "025", "018"}) {
+    const auto mesh = shell_mesh(name);
+    QuadraticGeometry<3> g(mesh);
+    gs[k] = std::abs(measure(g) / exact - 1);
+    project_boundary_edges(g, 1, onto_sphere<3>(Vec<3>::Zero(), a));
+    project_boundary_edges(g, 2, onto_sphere<3>(Vec<3>::Zero(), b));
+    gc[k] = std::abs(measure(g) / exact - 1);
+    n[k] = Real(mesh.n_cells());
+    CHECK(gc[k] < 0.01 * gs[k]);  // measured 3.5e-3 .. 2.5e-3 of it
+    ++k;
+  }
+  std::cout << "gmsh shells: relative volume error straight " << gs[0] << " " << gs[1] << " " << gs[2] << ", curved "
+            << gc[0] << " " << gc[1] << " " << gc[2] << "; orders straight " << observed_rate(n[0], gs[0], n[1], gs[1], 3)
+            << " " << observed_rate(n[1], gs[1], n[2], gs[2], 3) << ", curved "
+            << observed_rate(n[0], gc[0], n[1], gc[1], 3) << " " << observed_rate(n[1], gc[1], n[2], gc[2], 3) << "\n";
 }
 
 TEST_CASE("the curved Stokes kernel with edge points at the midpoints equals the affine kernel", "[curved][quick]") {

@@ -1,6 +1,7 @@
-// Isoparametric P2 geometry (fem/geometry.hpp): the quadratic map, its area / volume order, the
-// curved Stokes kernel against the affine one, and Taylor–Hood's rates on curved domains
-// restored (Couette flow in an annulus and in a spherical shell: L2 3, H1 2 instead of 2, 1.5).
+// Isoparametric P2 geometry (fem/geometry.hpp): the quadratic map, its area / volume order, edge
+// points that follow moving nodes, the curved Stokes and ALE Navier–Stokes kernels against the
+// affine ones, and Taylor–Hood's rates on curved domains restored (Couette flow in an annulus
+// and in a spherical shell: L2 3, H1 2 instead of 2, 1.5).
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -12,6 +13,7 @@
 #include "alefsi/fem/norms.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
 #include "alefsi/mesh/io/gmsh.hpp"
+#include "alefsi/physics/navier_stokes.hpp"
 #include "alefsi/physics/stokes.hpp"
 
 using namespace alefsi;
@@ -187,6 +189,69 @@ TEST_CASE("quadratic geometry: the shell's volume error drops from O(h^2) to O(h
             << observed_rate(n[0], gc[0], n[1], gc[1], 3) << " " << observed_rate(n[1], gc[1], n[2], gc[2], 3) << "\n";
 }
 
+TEST_CASE("edge points follow their nodes: rigidly with a rigid motion, at the frame rule's derivative otherwise",
+          "[curved][quick]") {
+  auto check = [](auto mesh, const auto& rotation) {
+    constexpr int D = std::decay_t<decltype(mesh)>::dim;
+    QuadraticGeometry<D> g(mesh);
+    project_boundary_edges(g, 1, onto_sphere<D>(Vec<D>::Zero(), a));
+    project_boundary_edges(g, 2, onto_sphere<D>(Vec<D>::Zero(), b));
+    const std::vector<Vec<D>> X0 = mesh.coordinates(), P0 = g.edge_points();
+    // a rigid motion x -> Q x + s of every node: the edge points move with it
+    const Mat<D> Q = rotation;
+    const Vec<D> shift = Vec<D>::LinSpaced(0.3, -0.2);
+    std::vector<Vec<D>> X1(X0.size());
+    for (std::size_t i = 0; i < X0.size(); ++i) X1[i] = Q * X0[i] + shift;
+    Real rigid = 0;
+    for (Index e = 0; e < mesh.n_edges(); ++e)
+      rigid = std::max(rigid, (g.edge_point(e, X1) - (Q * P0[std::size_t(e)] + shift)).norm());
+    // a rigid velocity field v0 + W x (W skew): the edge points' velocities are its values there
+    Mat<D> W = Mat<D>::Zero();
+    W(0, 1) = -0.7, W(1, 0) = 0.7;
+    if constexpr (D == 3) W(0, 2) = 0.4, W(2, 0) = -0.4, W(1, 2) = -0.25, W(2, 1) = 0.25;
+    const Vec<D> v0 = Vec<D>::LinSpaced(-0.5, 0.8);
+    std::vector<Vec<D>> V(X0.size());
+    for (std::size_t i = 0; i < X0.size(); ++i) V[i] = v0 + W * X0[i];
+    const auto We = g.edge_velocities(V);
+    Real vel = 0;
+    for (Index e = 0; e < mesh.n_edges(); ++e)
+      vel = std::max(vel, (We[std::size_t(e)] - (v0 + W * P0[std::size_t(e)])).norm());
+    // any other field: the derivative of edge_point(e, X + s V) at s = 0 (central differences)
+    for (std::size_t i = 0; i < X0.size(); ++i) V[i] = (X0[i].array() * 3.1).sin().matrix() + Vec<D>::Constant(0.2);
+    const auto Wg = g.edge_velocities(V);
+    const Real s = 1e-6;
+    std::vector<Vec<D>> Xp(X0.size()), Xm(X0.size());
+    for (std::size_t i = 0; i < X0.size(); ++i) Xp[i] = X0[i] + s * V[i], Xm[i] = X0[i] - s * V[i];
+    Real fd = 0;
+    for (Index e = 0; e < mesh.n_edges(); ++e)
+      fd = std::max(fd, ((g.edge_point(e, Xp) - g.edge_point(e, Xm)) / (2 * s) - Wg[std::size_t(e)]).norm());
+    // a body's surface turning while the nodes around it move otherwise: its edge points turn
+    // with it (their frames use the surface's nodes only)
+    std::vector<Vec<D>> X2 = X0;
+    for (std::size_t i = 0; i < X0.size(); ++i) X2[i] += 0.01 * V[i];
+    for (Index i : mesh.boundary_nodes(1)) X2[std::size_t(i)] = Q * X0[std::size_t(i)];
+    Real body = 0;
+    for (Index e : mesh.boundary_edges(1))
+      body = std::max(body, (g.edge_point(e, X2) - Q * P0[std::size_t(e)]).norm());
+    CHECK(body < 1e-14);
+    // update() after the mesh moved: the cached points are the moved ones
+    mesh.set_coordinates(X1);
+    g.update();
+    Real upd = 0;
+    for (Index e = 0; e < mesh.n_edges(); ++e)
+      upd = std::max(upd, (g.edge_point(e) - (Q * P0[std::size_t(e)] + shift)).norm());
+    std::cout << D << "D edge points: rigid motion " << rigid << ", rigid velocity " << vel << ", derivative vs FD " << fd
+              << ", a turning surface " << body << ", after update " << upd << "\n";
+    CHECK(rigid < 1e-14);
+    CHECK(vel < 1e-14);
+    CHECK(fd < 1e-8);
+    CHECK(upd < 1e-14);
+  };
+  const Real t = 0.8;
+  check(annulus_mesh(a, b, 3, 24), (Mat<2>() << std::cos(t), -std::sin(t), std::sin(t), std::cos(t)).finished());
+  check(spherical_shell_mesh(a, b, 1), Eigen::AngleAxis<Real>(t, Vec<3>(1, 2, 2).normalized()).toRotationMatrix());
+}
+
 TEST_CASE("the curved Stokes kernel with edge points at the midpoints equals the affine kernel", "[curved][quick]") {
   auto compare = [](const auto& mesh) {
     constexpr int D = std::decay_t<decltype(mesh)>::dim;
@@ -214,6 +279,62 @@ TEST_CASE("the curved Stokes kernel with edge points at the midpoints equals the
             << e3 << "\n";
   CHECK(e2 < 1e-13);
   CHECK(e3 < 1e-13);
+}
+
+TEST_CASE("the curved ALE Navier-Stokes kernel with edge points at the midpoints equals the affine kernel",
+          "[curved][quick]") {
+  // every term: mass with a history, theta = 1/2 with u^n, convection with a mesh velocity
+  // (edge velocities the midpoint averages, given explicitly and not), Newton and semi-implicit,
+  // a body force; and without convection (unsteady Stokes)
+  auto compare = []<bool Convection>(const auto& mesh, Linearisation lin, bool edge_velocities) {
+    constexpr int D = std::decay_t<decltype(mesh)>::dim;
+    using Kernel = AleNavierStokesKernel<D, TaylorHood, Convection>;
+    MixedSpace<D, TaylorHood> space(mesh);
+    Kernel affine(space, 1.3, 0.7, lin), curved(space, 1.3, 0.7, lin);
+    QuadraticGeometry<D> g(mesh);
+    for (Index e = 0; e < mesh.n_edges(); ++e) g.set_edge_point(e, g.edge_point(e));
+    REQUIRE(g.n_curved() == mesh.n_cells());
+    curved.set_geometry(&g);
+    const Index n = space.n_field();
+    VecX hist(n), prev(n), extra(n);
+    for (Index k = 0; k < n; ++k) {
+      hist[k] = std::sin(0.3 * Real(k)), prev[k] = std::cos(0.7 * Real(k)), extra[k] = std::sin(1.1 * Real(k) + 0.2);
+    }
+    std::vector<Vec<D>> mv(std::size_t(mesh.n_nodes())), ev(std::size_t(mesh.n_edges()));
+    for (Index v = 0; v < mesh.n_nodes(); ++v) mv[std::size_t(v)] = Vec<D>::Constant(0.4) + 0.5 * mesh.node(v);
+    for (Index e = 0; e < mesh.n_edges(); ++e)
+      ev[std::size_t(e)] = 0.5 * (mv[std::size_t(mesh.edge(e)[0])] + mv[std::size_t(mesh.edge(e)[1])]);
+    StepInputs<D> s{.dt = 0.05, .theta = 0.5, .a0 = 1.5, .history = &hist, .previous = &prev, .extrapolated = &extra,
+                    .mesh_velocity = &mv, .edge_velocity = edge_velocities ? &ev : nullptr,
+                    .force = [](const Vec<D>& x) { return Vec<D>(x.array().cos().matrix()); }};
+    affine.set_step(s);
+    curved.set_step(s);
+    typename Kernel::LocalVec u = Kernel::LocalVec::LinSpaced(-1, 2), r0, r1;
+    typename Kernel::LocalMat A0, A1;
+    Real worst = 0;
+    for (Index c = 0; c < mesh.n_cells(); ++c) {
+      affine.cell(c, u, A0, r0);
+      curved.cell(c, u, A1, r1);
+      worst = std::max({worst, (A1 - A0).cwiseAbs().maxCoeff() / A0.cwiseAbs().maxCoeff(),
+                        (r1 - r0).cwiseAbs().maxCoeff() / r0.cwiseAbs().maxCoeff()});
+    }
+    return worst;
+  };
+  for (auto lin : {Linearisation::newton, Linearisation::semi_implicit})
+    for (bool ev : {false, true}) {
+      const Real e2 = compare.template operator()<true>(annulus_mesh(a, b, 2, 12), lin, ev),
+                 e3 = compare.template operator()<true>(box_mesh(2, 2, 2), lin, ev);
+      std::cout << "curved NS kernel on straight cells against the affine kernel ("
+                << (lin == Linearisation::newton ? "Newton" : "semi-implicit") << (ev ? ", edge velocities" : "")
+                << "): max relative difference 2D " << e2 << ", 3D " << e3 << "\n";
+      CHECK(e2 < 1e-13);
+      CHECK(e3 < 1e-13);
+    }
+  const Real s2 = compare.template operator()<false>(annulus_mesh(a, b, 2, 12), Linearisation::newton, true),
+             s3 = compare.template operator()<false>(box_mesh(2, 2, 2), Linearisation::newton, true);
+  std::cout << "... unsteady Stokes: 2D " << s2 << ", 3D " << s3 << "\n";
+  CHECK(s2 < 1e-13);
+  CHECK(s3 < 1e-13);
 }
 
 TEST_CASE("an edge point that folds its cell is rejected, naming the cell", "[curved][quick]") {

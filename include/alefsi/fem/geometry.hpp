@@ -22,6 +22,16 @@
 /// of a degree-4 rule on every cell it curves and throws MeshError naming the cell otherwise
 /// (an edge point too far from the chord for the cell's size). The geometry refers to the mesh:
 /// the mesh must outlive it.
+///
+/// Moving meshes: a curved edge's point is stored in a frame of mesh nodes, so that it can be
+/// placed again after the nodes move (`update`, `edge_point(e, X)`) and its velocity follows
+/// from theirs (`edge_velocities`). With d = X_b - X_a and m = (X_a + X_b) / 2,
+///   2D:  P = m + alpha d + beta d^perp                    (linear in X)
+///   3D:  P = m + alpha d + beta f + gamma (d x f) / |d|,   f = X_c - m,
+/// X_c the third vertex of a boundary facet through the edge (of any cell through it when the
+/// edge is on no boundary facet). The coefficients are fixed when the point is set. Both rules
+/// commute with rotations, translations and scaling, so a point whose frame nodes move rigidly
+/// (a body's surface) moves rigidly with them, and its velocity is the rigid velocity there.
 #include <array>
 #include <cmath>
 #include <vector>
@@ -55,6 +65,34 @@ class QuadraticGeometry {
     std::vector<Index> fill(start_.begin(), start_.end() - 1);
     for (Index c = 0; c < mesh.n_cells(); ++c)
       for (Index e : mesh.cell_edges(c)) edge_cells_[std::size_t(fill[std::size_t(e)]++)] = c;
+    if constexpr (D == 3) {  // each edge's third frame vertex: from a boundary facet if it has one
+      partner_.assign(std::size_t(mesh.n_edges()), -1);
+      for (Index f : mesh.boundary_facets()) {
+        const auto& fv = mesh.facet(f);
+        const Index c = mesh.facet_cells(f)[0];
+        for (int le = 0; le < Shape::n_edge_dofs; ++le) {
+          const Index e = mesh.cell_edges(c)[le];
+          const auto& ev = mesh.edge(e);
+          int on = 0;
+          Index other = -1;
+          for (Index v : fv) {
+            if (v == ev[0] || v == ev[1]) ++on;
+            else other = v;
+          }
+          if (on == 2 && partner_[std::size_t(e)] < 0) partner_[std::size_t(e)] = other;
+        }
+      }
+      for (Index e = 0; e < mesh.n_edges(); ++e) {
+        if (partner_[std::size_t(e)] >= 0) continue;
+        for (Index v : mesh.cell(edge_cells_[std::size_t(start_[std::size_t(e)])]))
+          if (v != mesh.edge(e)[0] && v != mesh.edge(e)[1]) {
+            partner_[std::size_t(e)] = v;
+            break;
+          }
+      }
+    }
+    coef_.assign(std::size_t(mesh.n_edges()), Vec<D>::Zero());
+    moved_.assign(std::size_t(mesh.n_edges()), 0);
   }
 
   /// Edge points given for every edge (e.g. gmsh's second-order mid nodes,
@@ -84,10 +122,55 @@ class QuadraticGeometry {
 
   /// Moves the point of edge e to x and marks the cells around it curved. Call `check(c)` (or
   /// `check_all`) after the last move.
+  /// Its coordinates in the edge's frame (class comment) are fixed from the current nodes.
   void set_edge_point(Index e, const Vec<D>& x) {
     ALEFSI_CHECK_ARG(e >= 0 && e < mesh_->n_edges(), "e", "edge ", e, " out of range [0, ", mesh_->n_edges(), ")");
     points_[std::size_t(e)] = x;
+    const Frame F = frame(e, mesh_->coordinates());
+    coef_[std::size_t(e)] = F.axes.inverse() * (x - F.origin);
+    moved_[std::size_t(e)] = 1;
     for (Index k = start_[std::size_t(e)]; k < start_[std::size_t(e) + 1]; ++k) curved_[std::size_t(edge_cells_[std::size_t(k)])] = 1;
+  }
+
+  /// The point of edge e when the mesh nodes are at X (one position per node).
+  Vec<D> edge_point(Index e, const std::vector<Vec<D>>& X) const {
+    const Frame F = frame(e, X);
+    return moved_[std::size_t(e)] ? Vec<D>(F.origin + F.axes * coef_[std::size_t(e)]) : F.origin;
+  }
+  /// Places every edge point again from the mesh's current nodes (after `Mesh::set_coordinates`).
+  void update() {
+    for (Index e = 0; e < mesh_->n_edges(); ++e) points_[std::size_t(e)] = edge_point(e, mesh_->coordinates());
+  }
+  /// The velocity of every edge point when the mesh nodes, at their current positions, move at
+  /// V (one velocity per node): the derivative of the frame rule; the midpoint average on
+  /// straight edges.
+  std::vector<Vec<D>> edge_velocities(const std::vector<Vec<D>>& V) const {
+    ALEFSI_CHECK_ARG(Index(V.size()) == mesh_->n_nodes(), "V", "has ", V.size(), " entries, the mesh has ",
+                     mesh_->n_nodes(), " nodes");
+    const auto& X = mesh_->coordinates();
+    std::vector<Vec<D>> W(std::size_t(mesh_->n_edges()));
+    for (Index e = 0; e < mesh_->n_edges(); ++e) {
+      const auto& ev = mesh_->edge(e);
+      const Vec<D>&va = V[std::size_t(ev[0])], &vb = V[std::size_t(ev[1])];
+      Vec<D> w = 0.5 * (va + vb);
+      if (moved_[std::size_t(e)]) {
+        const Vec<D>& k = coef_[std::size_t(e)];
+        const Vec<D> d = X[std::size_t(ev[1])] - X[std::size_t(ev[0])], dd = vb - va;
+        if constexpr (D == 2) {
+          w += k[0] * dd + k[1] * Vec<D>(-dd[1], dd[0]);
+        } else {
+          const Index c = partner_[std::size_t(e)];
+          const Vec<D> f = X[std::size_t(c)] - 0.5 * (X[std::size_t(ev[0])] + X[std::size_t(ev[1])]);
+          const Vec<D> df = V[std::size_t(c)] - 0.5 * (va + vb);
+          const Real L = d.norm();
+          const Vec<D> n = d.cross(f);
+          const Vec<D> dn = (dd.cross(f) + d.cross(df)) / L - n * (d.dot(dd) / (L * L * L));
+          w += k[0] * dd + k[1] * df + k[2] * dn;
+        }
+      }
+      W[std::size_t(e)] = w;
+    }
+    return W;
   }
 
   /// The geometry nodes of cell c: its vertices, then its edge points (local edge order).
@@ -105,6 +188,11 @@ class QuadraticGeometry {
   Vec<D> dof_point(Index i) const {
     if (i < mesh_->n_nodes()) return mesh_->node(i);
     return points_[std::size_t(i - mesh_->n_nodes())];
+  }
+  /// ... when the mesh nodes are at X.
+  Vec<D> dof_point(Index i, const std::vector<Vec<D>>& X) const {
+    if (i < mesh_->n_nodes()) return X[std::size_t(i)];
+    return edge_point(i - mesh_->n_nodes(), X);
   }
 
   /// x(xi) on cell nodes X.
@@ -150,10 +238,34 @@ class QuadraticGeometry {
  private:
   Vec<D> midpoint(Index e) const { return 0.5 * (mesh_->node(mesh_->edge(e)[0]) + mesh_->node(mesh_->edge(e)[1])); }
 
+  // The frame of edge e at node positions X: origin m, axes (d, d^perp) or (d, f, d x f / |d|).
+  struct Frame {
+    Vec<D> origin;
+    Mat<D> axes;
+  };
+  Frame frame(Index e, const std::vector<Vec<D>>& X) const {
+    const auto& ev = mesh_->edge(e);
+    const Vec<D>&a = X[std::size_t(ev[0])], &b = X[std::size_t(ev[1])];
+    Frame F{0.5 * (a + b), Mat<D>::Zero()};
+    const Vec<D> d = b - a;
+    F.axes.col(0) = d;
+    if constexpr (D == 2) {
+      F.axes.col(1) = Vec<D>(-d[1], d[0]);
+    } else {
+      const Vec<D> f = X[std::size_t(partner_[std::size_t(e)])] - F.origin;
+      F.axes.col(1) = f;
+      F.axes.col(2) = d.cross(f) / d.norm();
+    }
+    return F;
+  }
+
   const Mesh<D>* mesh_;
   std::vector<Vec<D>> points_;
   std::vector<char> curved_;
   std::vector<Index> start_, edge_cells_;
+  std::vector<Index> partner_;  // 3D: each edge's third frame vertex
+  std::vector<Vec<D>> coef_;    // a moved edge point's coordinates in its frame
+  std::vector<char> moved_;     // the edge point was set (else: the midpoint)
 };
 
 /// Places the point of every edge lying on a boundary facet with tag `tag` at onto(midpoint)

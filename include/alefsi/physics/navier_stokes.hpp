@@ -28,6 +28,7 @@
 /// `Convection = false` drops every convective term at compile time (unsteady Stokes).
 #include <cmath>
 #include <functional>
+#include <type_traits>
 #include <vector>
 
 #include "alefsi/core/error.hpp"
@@ -50,6 +51,9 @@ struct StepInputs {
   const VecX* previous = nullptr;    ///< u^n (field vector), used when theta < 1
   const VecX* extrapolated = nullptr;///< u* (field vector): convecting velocity / tau
   const std::vector<Vec<D>>* mesh_velocity = nullptr;  ///< per mesh node, at n+theta
+  /// Per mesh edge: the mesh velocity at its edge point (curved cells of a `QuadraticGeometry`);
+  /// null: the average of the edge's end nodes (the P1 mesh velocity, as on straight cells).
+  const std::vector<Vec<D>>* edge_velocity = nullptr;
   VectorFunction<D> force;           ///< body force per unit volume at t^{n+theta} (may be empty)
 };
 
@@ -63,8 +67,10 @@ struct StepInputs {
 ///   rule of the exact degree of their polynomial integrands), called once per cell
 ///   (`add_cell`) and at every force point (`add_force`).
 /// - The body-force terms (not polynomial) with the former rule of degree 3k + 1.
-/// Equal to the quadrature oracle (tests/support/oracle_kernels.hpp) to round-off. `cell` is
-/// const and thread-safe (so must the force function be).
+/// Equal to the quadrature oracle (tests/support/oracle_kernels.hpp) to round-off.
+/// With a `QuadraticGeometry` (Taylor–Hood), curved cells take `curved_cell`: every term by the
+/// rule of degree 3k + 1 through the isoparametric map, the mesh velocity interpolated on the
+/// geometry's P2 nodes. `cell` is const and thread-safe (so must the force function be).
 template <int D, ElementPair Pair, bool Convection = true>
 class AleNavierStokesKernel {
  public:
@@ -89,6 +95,22 @@ class AleNavierStokesKernel {
   }
 
   void set_step(const StepInputs<D>& s) { s_ = s; }
+
+  /// Integrates the curved cells of `g` through their quadratic map (null: every cell affine).
+  /// The geometry must be on this kernel's mesh (its nodes where the step's geometry is, as
+  /// the mesh's are) and outlive the kernel.
+  void set_geometry(const QuadraticGeometry<D>* g)
+    requires(V::degree == 2 && std::is_empty_v<Stabilisation>)
+  {
+    ALEFSI_CHECK_ARG(!g || &g->mesh() == &space_->mesh(), "geometry", "is on another mesh than the space's");
+    geom_ = g;
+    if (g && geo_dN_.empty())
+      for (int q = 0; q < ftab_.rule->size(); ++q) {
+        geo_N_.push_back(QuadraticGeometry<D>::Shape::values(ftab_.rule->points[q]));
+        geo_dN_.push_back(QuadraticGeometry<D>::Shape::gradients(ftab_.rule->points[q]));
+      }
+  }
+  const QuadraticGeometry<D>* geometry() const { return geom_; }
   Linearisation linearisation() const { return lin_; }
 
   /// The GLS parameter `gls_tau` of cell c at the current step for the convecting velocity
@@ -99,6 +121,7 @@ class AleNavierStokesKernel {
   }
 
   void cell(Index c, const LocalVec& u, LocalMat& A, LocalVec& r) const {
+    if (geom_ && geom_->curved(c)) return curved_cell(c, u, A, r);
     const auto& mesh = space_->mesh();
     const Mat<D> J = mesh.jacobian(c);
     const Mat<D> Jinv = J.inverse();
@@ -106,19 +129,9 @@ class AleNavierStokesKernel {
     const auto& fd = space_->cell_field_dofs(c);
     const Real th = s_.theta, dt = s_.dt, a0 = s_.a0;
     const bool newton = Convection && lin_ == Linearisation::newton;
-    // local nodal data
     Nodal U, Uth, H, Us;
     Eigen::Matrix<Real, np, 1> Pl;
-    for (int a = 0; a < nv; ++a)
-      for (int i = 0; i < D; ++i) {
-        const int l = D * a + i;
-        U(a, i) = u[l];
-        const Real un = s_.previous ? (*s_.previous)[fd[l]] : u[l];
-        Uth(a, i) = th * u[l] + (1 - th) * un;
-        H(a, i) = s_.history ? (*s_.history)[fd[l]] : 0.0;
-        Us(a, i) = s_.extrapolated ? (*s_.extrapolated)[fd[l]] : Uth(a, i);
-      }
-    for (int b = 0; b < np; ++b) Pl[b] = u[D * nv + b];
+    gather(fd, u, U, Uth, H, Us, Pl);
     Eigen::Matrix<Real, D + 1, D> Vm = Eigen::Matrix<Real, D + 1, D>::Zero();  // mesh velocity at vertices
     if (s_.mesh_velocity)
       for (int a = 0; a <= D; ++a) Vm.row(a) = (*s_.mesh_velocity)[mesh.cell(c)[a]].transpose();
@@ -207,7 +220,110 @@ class AleNavierStokesKernel {
     }
   }
 
+  /// Cell c through the isoparametric map (Taylor–Hood): at each point of the rule of degree
+  /// 3k + 1, J(xi), physical gradients G = dphi J^-1, weight w det J(xi), and with
+  /// u_th, u* and p at the point, v the mesh velocity interpolated on the geometry's P2 nodes
+  /// (vertices: `mesh_velocity`; edge points: `edge_velocity`), a = c - v:
+  ///   r(a, i) += w [rho (D_t u_i + (a . grad) u_th,i) phi_a + mu (d_j u_th,i + d_i u_th,j) G_aj
+  ///                 - p G_ai - f_i phi_a],      r(p_b) -= w psi_b div u_th
+  ///   A(a i, b j) += w [delta_ij (rho a0 / dt phi_a phi_b + theta (mu G_a . G_b + rho phi_a a . G_b))
+  ///                     + theta mu G_aj G_bi + (Newton) theta rho phi_a phi_b d_j u_th,i]
+  ///   A(a i, p_b) -= w psi_b G_ai,   A(p_b, a i) -= theta w psi_b G_ai.
+  /// Equal to the affine path when the edge points are the midpoints (tested).
+  void curved_cell(Index c, const LocalVec& u, LocalMat& A, LocalVec& r) const {
+    using Geometry = QuadraticGeometry<D>;
+    constexpr int ng = Geometry::n_nodes;
+    const auto& mesh = space_->mesh();
+    const auto X = geom_->cell_nodes(c);
+    const auto& fd = space_->cell_field_dofs(c);
+    const Real th = s_.theta, dt = s_.dt, a0 = s_.a0;
+    const bool newton = Convection && lin_ == Linearisation::newton;
+    Nodal U, Uth, H, Us;
+    Eigen::Matrix<Real, np, 1> Pl;
+    gather(fd, u, U, Uth, H, Us, Pl);
+    const Nodal Dt = (a0 * U + H) / dt;  // nodal D_t u
+    Eigen::Matrix<Real, ng, D> Vg = Eigen::Matrix<Real, ng, D>::Zero();  // mesh velocity at the geometry nodes
+    if (s_.mesh_velocity) {
+      const auto& cv = mesh.cell(c);
+      for (int a = 0; a <= D; ++a) Vg.row(a) = (*s_.mesh_velocity)[std::size_t(cv[a])].transpose();
+      const auto& ce = mesh.cell_edges(c);
+      for (int k = 0; k < Geometry::Shape::n_edge_dofs; ++k) {
+        const auto& ab = SimplexTopology<D>::edges[k];
+        Vg.row(D + 1 + k) = s_.edge_velocity ? (*s_.edge_velocity)[std::size_t(ce[k])].transpose()
+                                             : Eigen::Matrix<Real, 1, D>(0.5 * (Vg.row(ab[0]) + Vg.row(ab[1])));
+      }
+    }
+    A.setZero();
+    r.setZero();
+    const auto& rule = *ftab_.rule;
+    for (int q = 0; q < rule.size(); ++q) {
+      const Mat<D> J = Geometry::jacobian(X, geo_dN_[std::size_t(q)]);
+      const Real w = rule.weights[q] * J.determinant();
+      const Eigen::Matrix<Real, nv, D> G = ftab_.dphi_v[q] * J.inverse();
+      const auto& phi = ftab_.phi_v[q];
+      const auto& psi = ftab_.phi_p[q];
+      const Eigen::Matrix<Real, nv, 1> ph = Eigen::Map<const Eigen::Matrix<Real, nv, 1>>(phi.data());
+      const Mat<D> gu = Uth.transpose() * G;  // (i, j) = d_j u_th,i
+      const Vec<D> dtu = Dt.transpose() * ph;
+      const Real pq = psi.dot(Pl);
+      Vec<D> conv = Vec<D>::Zero();
+      Eigen::Matrix<Real, nv, 1> aG = Eigen::Matrix<Real, nv, 1>::Zero();  // a . G_b
+      if constexpr (Convection) {
+        const Vec<D> cq = (newton ? Uth : Us).transpose() * ph;
+        const Vec<D> vq = Vg.transpose() * Eigen::Map<const Eigen::Matrix<Real, ng, 1>>(geo_N_[std::size_t(q)].data());
+        const Vec<D> aq = cq - vq;
+        conv = gu * aq;
+        aG = G * aq;
+      }
+      Vec<D> fq = Vec<D>::Zero();
+      if (s_.force) fq = s_.force(Geometry::map(X, geo_N_[std::size_t(q)]));
+      const Mat<D> sym = mu_ * (gu + gu.transpose());
+      const Vec<D> rhs = rho_ * (dtu + conv) - fq;
+      for (int a = 0; a < nv; ++a)
+        for (int i = 0; i < D; ++i)
+          r[D * a + i] += w * (rhs[i] * ph[a] + sym.row(i).dot(G.row(a)) - pq * G(a, i));
+      const Real div = gu.trace();
+      for (int b = 0; b < np; ++b) r[D * nv + b] -= w * psi[b] * div;
+      // Jacobian
+      const Eigen::Matrix<Real, nv, nv> diag =
+          w * ((rho_ * a0 / dt) * ph * ph.transpose() + th * (mu_ * G * G.transpose() + rho_ * ph * aG.transpose()));
+      for (int a = 0; a < nv; ++a)
+        for (int b = 0; b < nv; ++b)
+          for (int i = 0; i < D; ++i) {
+            A(D * a + i, D * b + i) += diag(a, b);
+            for (int j = 0; j < D; ++j) {
+              Real v = th * mu_ * G(a, j) * G(b, i);
+              if (newton) v += th * rho_ * ph[a] * ph[b] * gu(i, j);
+              A(D * a + i, D * b + j) += w * v;
+            }
+          }
+      for (int a = 0; a < nv; ++a)
+        for (int i = 0; i < D; ++i)
+          for (int b = 0; b < np; ++b) {
+            const Real v = w * psi[b] * G(a, i);
+            A(D * a + i, D * nv + b) -= v;
+            A(D * nv + b, D * a + i) -= th * v;
+          }
+    }
+  }
+
  private:
+  /// The cell's nodal data: u^{n+1}, u_th, the history sum, u* and the pressure.
+  void gather(const typename Space::CellDofs& fd, const LocalVec& u, Nodal& U, Nodal& Uth, Nodal& H, Nodal& Us,
+              Eigen::Matrix<Real, np, 1>& Pl) const {
+    const Real th = s_.theta;
+    for (int a = 0; a < nv; ++a)
+      for (int i = 0; i < D; ++i) {
+        const int l = D * a + i;
+        U(a, i) = u[l];
+        const Real un = s_.previous ? (*s_.previous)[fd[l]] : u[l];
+        Uth(a, i) = th * u[l] + (1 - th) * un;
+        H(a, i) = s_.history ? (*s_.history)[fd[l]] : 0.0;
+        Us(a, i) = s_.extrapolated ? (*s_.extrapolated)[fd[l]] : Uth(a, i);
+      }
+    for (int b = 0; b < np; ++b) Pl[b] = u[D * nv + b];
+  }
+
   const Space* space_;
   Real rho_, mu_;
   Linearisation lin_;
@@ -216,6 +332,9 @@ class AleNavierStokesKernel {
   [[no_unique_address]] Stabilisation stab_;  // empty without stabilisation
   ReferenceTables<D, Pair> ftab_;
   StepInputs<D> s_;
+  const QuadraticGeometry<D>* geom_ = nullptr;
+  std::vector<typename QuadraticGeometry<D>::Shape::Values> geo_N_;     // geometry shape values at ftab_'s points
+  std::vector<typename QuadraticGeometry<D>::Shape::Gradients> geo_dN_;  // ... and their reference gradients
 };
 
 }  // namespace alefsi

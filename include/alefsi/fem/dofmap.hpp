@@ -3,7 +3,9 @@
 /// Global DOF numbering of scalar Lagrange spaces and of velocity/pressure spaces.
 ///
 /// Scalar space (`DofMap<E, D>`): the DOF on mesh node v is v; the DOF on mesh edge e is
-/// n_nodes + e. Cell c's DOFs come in the element's local order.
+/// n_nodes + e. Cell c's DOFs come in the element's local order. An edge DOF sits at the edge's
+/// midpoint, or at its point of a `QuadraticGeometry` given by `set_geometry` (isoparametric
+/// P2: `point` then follows the curved edges, for every user of the space).
 ///
 /// Mixed space (`MixedSpace<D, Pair>`): the *field* vector holds every velocity component at
 /// every velocity DOF, interleaved (field index i*D + c for component c of scalar DOF i), then
@@ -21,6 +23,7 @@
 #include "alefsi/core/error.hpp"
 #include "alefsi/fem/concepts.hpp"
 #include "alefsi/fem/element_pair.hpp"
+#include "alefsi/fem/geometry.hpp"
 #include "alefsi/mesh/mesh.hpp"
 
 namespace alefsi {
@@ -42,9 +45,10 @@ class DofMap {
 
   Index n_dofs() const { return n_dofs_; }
   const CellDofs& cell_dofs(Index c) const { return cell_dofs_[c]; }
-  /// Physical location of global DOF i (node, or midpoint of the straight edge).
+  /// Physical location of global DOF i (node, or the edge's midpoint or geometry point).
   Vec<D> point(Index i) const {
     if (i < mesh_->n_nodes()) return mesh_->node(i);
+    if (geometry_) return geometry_->edge_point(i - mesh_->n_nodes());
     const auto& e = mesh_->edge(i - mesh_->n_nodes());
     return 0.5 * (mesh_->node(e[0]) + mesh_->node(e[1]));
   }
@@ -52,9 +56,17 @@ class DofMap {
   /// past or predicted configuration of a moving mesh).
   Vec<D> point(Index i, const std::vector<Vec<D>>& x) const {
     if (i < mesh_->n_nodes()) return x[std::size_t(i)];
+    if (geometry_) return geometry_->edge_point(i - mesh_->n_nodes(), x);
     const auto& e = mesh_->edge(i - mesh_->n_nodes());
     return 0.5 * (x[std::size_t(e[0])] + x[std::size_t(e[1])]);
   }
+  /// Edge DOFs at the points of `g` (null: the midpoints); g must be on this map's mesh and
+  /// outlive the map's use of it.
+  void set_geometry(const QuadraticGeometry<D>* g) {
+    ALEFSI_CHECK_ARG(!g || &g->mesh() == mesh_, "geometry", "is on another mesh than the DOF map's");
+    geometry_ = g;
+  }
+  const QuadraticGeometry<D>* geometry() const { return geometry_; }
   /// The DOF on mesh node v (vertex DOFs come first, in node order).
   Index node_dof(Index v) const { return v; }
   /// Global DOFs on boundary facets with the given tag (sorted).
@@ -68,6 +80,7 @@ class DofMap {
 
  private:
   const Mesh<D>* mesh_;
+  const QuadraticGeometry<D>* geometry_ = nullptr;
   Index n_dofs_ = 0;
   std::vector<CellDofs> cell_dofs_;
 };
@@ -86,6 +99,9 @@ class MixedSpace {
   explicit MixedSpace(const Mesh<D>& mesh) : velocity_(mesh), pressure_(mesh) {}
 
   const Mesh<D>& mesh() const { return velocity_.mesh(); }
+  /// Isoparametric P2: the velocity's edge DOFs at the points of `g` (null: the midpoints).
+  void set_geometry(const QuadraticGeometry<D>* g) { velocity_.set_geometry(g); }
+  const QuadraticGeometry<D>* geometry() const { return velocity_.geometry(); }
   const DofMap<VelocityElement, D>& velocity() const { return velocity_; }
   const DofMap<PressureElement, D>& pressure() const { return pressure_; }
   Index n_field() const { return D * velocity_.n_dofs() + pressure_.n_dofs(); }

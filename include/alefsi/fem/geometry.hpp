@@ -23,9 +23,10 @@
 /// (an edge point too far from the chord for the cell's size). The geometry refers to the mesh:
 /// the mesh must outlive it.
 ///
-/// Moving meshes: a curved edge's point is stored in a frame of mesh nodes, so that it can be
-/// placed again after the nodes move (`update`, `edge_point(e, X)`) and its velocity follows
-/// from theirs (`edge_velocities`). With d = X_b - X_a and m = (X_a + X_b) / 2,
+/// Moving meshes: a curved edge's point is stored in a frame of mesh nodes and computed from the
+/// mesh's current nodes whenever it is asked for (so it follows `Mesh::set_coordinates` with
+/// nothing to update; `edge_point(e, X)` at other positions), and its velocity follows from
+/// theirs (`edge_velocities`). With d = X_b - X_a and m = (X_a + X_b) / 2,
 ///   2D:  P = m + alpha d + beta d^perp                    (linear in X)
 ///   3D:  P = m + alpha d + beta f + gamma (d x f) / |d|,   f = X_c - m,
 /// X_c the third vertex of a boundary facet through the edge (of any cell through it when the
@@ -53,8 +54,6 @@ class QuadraticGeometry {
 
   /// Straight edges: every edge point at its midpoint (the affine geometry).
   explicit QuadraticGeometry(const Mesh<D>& mesh) : mesh_(&mesh) {
-    points_.resize(std::size_t(mesh.n_edges()));
-    for (Index e = 0; e < mesh.n_edges(); ++e) points_[std::size_t(e)] = midpoint(e);
     curved_.assign(std::size_t(mesh.n_cells()), 0);
     // the cells around each edge, compressed: cells of e at edge_cells_[start_[e] .. start_[e + 1])
     start_.assign(std::size_t(mesh.n_edges()) + 1, 0);
@@ -108,9 +107,14 @@ class QuadraticGeometry {
   }
 
   const Mesh<D>& mesh() const { return *mesh_; }
-  /// The point of edge e (its midpoint unless curved).
-  const Vec<D>& edge_point(Index e) const { return points_[std::size_t(e)]; }
-  const std::vector<Vec<D>>& edge_points() const { return points_; }
+  /// The point of edge e at the mesh's current nodes (its midpoint unless curved).
+  Vec<D> edge_point(Index e) const { return edge_point(e, mesh_->coordinates()); }
+  /// Every edge's point (e.g. for `write_vtu`'s quadratic cells).
+  std::vector<Vec<D>> edge_points() const {
+    std::vector<Vec<D>> out(std::size_t(mesh_->n_edges()));
+    for (Index e = 0; e < mesh_->n_edges(); ++e) out[std::size_t(e)] = edge_point(e);
+    return out;
+  }
   /// True when cell c has a displaced edge point (its map is not affine).
   bool curved(Index c) const { return curved_[std::size_t(c)] != 0; }
   /// Number of curved cells.
@@ -125,7 +129,6 @@ class QuadraticGeometry {
   /// Its coordinates in the edge's frame (class comment) are fixed from the current nodes.
   void set_edge_point(Index e, const Vec<D>& x) {
     ALEFSI_CHECK_ARG(e >= 0 && e < mesh_->n_edges(), "e", "edge ", e, " out of range [0, ", mesh_->n_edges(), ")");
-    points_[std::size_t(e)] = x;
     const Frame F = frame(e, mesh_->coordinates());
     coef_[std::size_t(e)] = F.axes.inverse() * (x - F.origin);
     moved_[std::size_t(e)] = 1;
@@ -136,10 +139,6 @@ class QuadraticGeometry {
   Vec<D> edge_point(Index e, const std::vector<Vec<D>>& X) const {
     const Frame F = frame(e, X);
     return moved_[std::size_t(e)] ? Vec<D>(F.origin + F.axes * coef_[std::size_t(e)]) : F.origin;
-  }
-  /// Places every edge point again from the mesh's current nodes (after `Mesh::set_coordinates`).
-  void update() {
-    for (Index e = 0; e < mesh_->n_edges(); ++e) points_[std::size_t(e)] = edge_point(e, mesh_->coordinates());
   }
   /// The velocity of every edge point when the mesh nodes, at their current positions, move at
   /// V (one velocity per node): the derivative of the frame rule; the midpoint average on
@@ -179,7 +178,7 @@ class QuadraticGeometry {
     const auto& v = mesh_->cell(c);
     for (int i = 0; i <= D; ++i) X[i] = mesh_->node(v[i]);
     const auto& e = mesh_->cell_edges(c);
-    for (int k = 0; k < Shape::n_edge_dofs; ++k) X[D + 1 + k] = points_[std::size_t(e[k])];
+    for (int k = 0; k < Shape::n_edge_dofs; ++k) X[D + 1 + k] = edge_point(e[k]);
     return X;
   }
 
@@ -187,7 +186,7 @@ class QuadraticGeometry {
   /// edge): a node, or the edge point.
   Vec<D> dof_point(Index i) const {
     if (i < mesh_->n_nodes()) return mesh_->node(i);
-    return points_[std::size_t(i - mesh_->n_nodes())];
+    return edge_point(i - mesh_->n_nodes());
   }
   /// ... when the mesh nodes are at X.
   Vec<D> dof_point(Index i, const std::vector<Vec<D>>& X) const {
@@ -260,7 +259,6 @@ class QuadraticGeometry {
   }
 
   const Mesh<D>* mesh_;
-  std::vector<Vec<D>> points_;
   std::vector<char> curved_;
   std::vector<Index> start_, edge_cells_;
   std::vector<Index> partner_;  // 3D: each edge's third frame vertex

@@ -250,7 +250,7 @@ class Stokes {
     requires(Space::VelocityElement::degree == 2)
   {
     kernel_.set_geometry(&g);
-    geom_ = &g;
+    space_.set_geometry(&g);
   }
 
   /// Prescribes the velocity on the boundary facets with tag `tag`.
@@ -272,7 +272,7 @@ class Stokes {
     const auto& vel = space_.velocity();
     std::vector<char> taken(vel.n_dofs(), 0);
     for (const auto& [i, tag] : fix_velocity_on_tags(space_, dirichlet_, cons, taken)) {
-      const Vec<D> val = dirichlet_.at(tag)(geom_ ? geom_->dof_point(i) : vel.point(i));
+      const Vec<D> val = dirichlet_.at(tag)(vel.point(i));
       for (int k = 0; k < D; ++k) cons.set_fixed_value(space_.velocity_field(i, k), val[k]);
     }
     pinned_ = whole_boundary_prescribed(space_.mesh(), [&](int tag) { return dirichlet_.count(tag) > 0; });
@@ -292,15 +292,16 @@ class Stokes {
   }
 
   /// Adds a constant to the pressure so that its mean over the domain is zero.
-  void shift_pressure_to_zero_mean(VecX& field) const { alefsi::shift_pressure_to_zero_mean(space_, field, geom_); }
+  void shift_pressure_to_zero_mean(VecX& field) const {
+    alefsi::shift_pressure_to_zero_mean(space_, field, space_.geometry());
+  }
   /// The geometry set by `set_geometry` (null: affine cells).
-  const QuadraticGeometry<D>* geometry() const { return geom_; }
+  const QuadraticGeometry<D>* geometry() const { return space_.geometry(); }
 
  private:
   Space space_;
   Kernel kernel_;
   std::map<int, VectorFunction<D>> dirichlet_;
-  const QuadraticGeometry<D>* geom_ = nullptr;
   bool pinned_ = false;
 };
 

@@ -64,6 +64,7 @@ class Discretisation {
   /// A new mesh topology: new space, kernel and motion operator; no constraints or pattern
   /// until `constrain`; the solver analyses the next matrix afresh.
   void rebuild(const Mesh<D>& mesh) {
+    geometry_ = nullptr;
     space_ = std::make_unique<Space>(mesh);
     kernel_ = std::make_unique<Kernel>(*space_, opt_.rho, opt_.mu, opt_.linearisation);
     motion_ = std::make_unique<Motion>(mesh);
@@ -96,6 +97,18 @@ class Discretisation {
   }
   bool constrained() const { return cons_ != nullptr; }
 
+  /// Isoparametric P2 (Taylor–Hood): the kernel integrates the curved cells of `g` and the
+  /// velocity's edge DOFs sit at its points; the kernel gets the edge points' velocities each
+  /// step. Null: straight cells. A rebuild drops it (the geometry is on the old mesh).
+  void set_geometry(const QuadraticGeometry<D>* g)
+    requires(Space::VelocityElement::degree == 2)
+  {
+    space_->set_geometry(g);
+    kernel_->set_geometry(g);
+    geometry_ = g;
+  }
+  const QuadraticGeometry<D>* geometry() const { return geometry_; }
+
   /// The kernel's inputs for the step with coefficients c: the BDF history of the time
   /// derivative sum_{k>=1} a_k U^{n+1-k}, the extrapolated (convecting) velocity u*, U^n, the
   /// mesh velocity the flow sees (per node) and the body force. `U` and `Vflow` are read
@@ -110,6 +123,10 @@ class Discretisation {
     StepInputs<D> in;
     in.dt = c.dt, in.theta = c.theta, in.a0 = c.flow_bdf[0], in.tau_dt = opt_.tau_dt;
     in.history = &hist_, in.previous = &U[0], in.extrapolated = &ustar_, in.mesh_velocity = &Vflow;
+    if (geometry_) {  // the edge points' velocities, at the mesh's current (the step's flow) nodes
+      edge_velocity_ = geometry_->edge_velocities(Vflow);
+      in.edge_velocity = &edge_velocity_;
+    }
     in.force = std::move(force);
     kernel_->set_step(in);
   }
@@ -152,6 +169,8 @@ class Discretisation {
   bool pinned_ = false;
   Real gamma_ = -1;
   VecX hist_, ustar_;  // the step's kernel inputs
+  const QuadraticGeometry<D>* geometry_ = nullptr;
+  std::vector<Vec<D>> edge_velocity_;  // the step's edge-point velocities (curved geometry)
 };
 
 }  // namespace alefsi

@@ -213,6 +213,8 @@ RunSummary run(Flow& flow, const RunOptions& opt) {
   opt.validate();
   ALEFSI_CHECK_ARG(opt.t_end > flow.time(), "t_end", "must exceed the flow's time ", flow.time(), ", got ", opt.t_end);
   flow.prepare();  // a scene that cannot run is refused before anything is written
+  ALEFSI_CHECK_ARG(opt.checkpoint_every == 0 || opt.output.empty() || !flow.geometry(), "checkpoint_every",
+                   "flows with curved boundaries cannot be checkpointed yet: set it to 0");
   const auto wall0 = std::chrono::steady_clock::now();
   auto wall = [&] { return std::chrono::duration<Real>(std::chrono::steady_clock::now() - wall0).count(); };
   const std::size_t nb = flow.n_bodies();

@@ -149,6 +149,44 @@ TEST_CASE("adapt: annulus with the inner disk rotated by 2 pi, adapted every ste
   CHECK(ops > 1000);  // the mesh was really reconnected
 }
 
+TEST_CASE("adapt: an ellipse turned in a box, adapted every step: nodes stay on the ellipse", "[mesh][adapt]") {
+  // an ellipse (aspect 3) turned by pi / 2 in 20 steps with a smooth ALE rotation field; each
+  // adaptation is given the ellipse at its new angle, and new or sliding nodes land on it
+  const Polyline box{{Vec<2>(-1.5, -1.5), Vec<2>(1.5, -1.5), Vec<2>(1.5, 1.5), Vec<2>(-1.5, 1.5)}, 9};
+  Ellipse body{Vec<2>::Zero(), 0.6, 0.2, 0.0, 1};
+  const double h = 0.06;
+  Mesh<2> m = generate_mesh(Domain2D{box, {body}}, MesherOptions{uniform_size(h)});
+  AdaptOptions opt;
+  opt.size = uniform_size(h);
+  const int steps = 20;
+  const double dtheta = 0.5 * pi / steps;
+  double worst_q = 1, worst_level = 0;
+  int ops = 0;
+  for (int s = 0; s < steps; ++s) {
+    std::vector<Vec<2>> x = m.coordinates();
+    for (auto& p : x) {  // w = 1 inside r = 0.6, 0 beyond r = 1.4
+      const double u = std::clamp((p.norm() - 0.6) / 0.8, 0.0, 1.0), a = dtheta * 0.5 * (1 + std::cos(pi * u));
+      p = Vec<2>(std::cos(a) * p[0] - std::sin(a) * p[1], std::sin(a) * p[0] + std::cos(a) * p[1]);
+    }
+    Mesh<2> moved = m;
+    moved.set_coordinates(x);
+    body.angle += dtheta;
+    AdaptReport rep;
+    m = adapt(moved, {box, body}, opt, &rep);
+    worst_q = std::min(worst_q, rep.worst_quality);
+    ops += rep.splits + rep.collapses + rep.flips;
+    for (Index v : m.boundary_nodes(1)) worst_level = std::max(worst_level, std::abs(body.level(m.node(v)) - 1));
+    check_boundary_tags(m, {1, 9});
+  }
+  std::printf("ellipse turned by pi/2: worst quality %.3f, worst |level - 1| on the ellipse %.2e, %d operations\n",
+              worst_q, worst_level, ops);
+  CHECK(worst_level < 1e-12);  // rotated nodes carry round-off of the rotation; new ones are exact
+  CHECK(worst_q >= 0.55);      // the annulus test's floor
+  CHECK(ops > 100);
+  // the mesh's measure: the box minus the polygon through the ellipse's nodes
+  CHECK(m.total_measure() == Approx(9 - tagged_polygon_area(m, 1, Vec<2>::Zero())).epsilon(1e-12));
+}
+
 TEST_CASE("adapt: disk translated across a channel, adapted every step", "[mesh][adapt]") {
   const double W = 6, H = 2, r = 0.125, hb = 0.02, travel = 1.5;  // 6 diameters
   const int steps = 60;

@@ -289,6 +289,57 @@ TEST_CASE("curved_edge_midpoints puts boundary midpoints on the circles", "[mesh
     if (!curved[e]) CHECK((mid[e] - 0.5 * (m.node(m.edge(e)[0]) + m.node(m.edge(e)[1]))).norm() == 0);
 }
 
+TEST_CASE("elliptic holes: nodes on the ellipses, angles, area, curved midpoints", "[mesh][mesher]") {
+  // two tilted ellipses (aspect 2 and 4) in a box
+  const Polyline box{{Vec<2>(-2, -2), Vec<2>(2, -2), Vec<2>(2, 2), Vec<2>(-2, 2)}, 9};
+  const Ellipse e1{Vec<2>(-0.8, 0.1), 0.6, 0.3, 0.4, 1}, e2{Vec<2>(0.9, -0.2), 0.8, 0.2, -1.1, 2};
+  const Domain2D dom{box, {e1, e2}};
+  MesherReport rep;
+  const Mesh<2> m = generate_mesh(dom, MesherOptions{uniform_size(0.04)}, &rep);
+  CHECK(min_angle_deg(m) >= 25.0);
+  CHECK(rep.dropped == 0);
+  for (Index f : m.boundary_facets()) {
+    const int tag = m.facet_tag(f);
+    if (tag == 9) continue;
+    REQUIRE((tag == 1 || tag == 2));
+    const Ellipse& e = tag == 1 ? e1 : e2;
+    for (Index v : m.facet(f)) CHECK(std::abs(e.level(m.node(v)) - 1) < 1e-14);
+  }
+  // the mesh's measure: the box minus the polygons through the ellipses' nodes
+  const double holes = tagged_polygon_area(m, 1, e1.centre) + tagged_polygon_area(m, 2, e2.centre);
+  CHECK(m.total_measure() == Approx(16 - holes).epsilon(1e-12));
+  // curved midpoints at the parameter midpoint: the ellipse is the affine image (det a b) of
+  // the unit circle, so the parabolic segment over an edge spanning dt of parameter has the
+  // area of the unit circle's, a b 4/3 sin(dt/2) (1 - cos(dt/2)) (Archimedes: 4/3 of the
+  // triangle), and the elliptic segment a b (dt - sin dt) / 2
+  const auto mid = curved_edge_midpoints(m, dom);
+  double polygon_defect = 0, quadratic_defect = 0;
+  for (int tag : {1, 2})
+    for (Index e : m.boundary_edges(tag)) {
+      const Ellipse& el = tag == 1 ? e1 : e2;
+      const Vec<2> A = m.node(m.edge(e)[0]), B = m.node(m.edge(e)[1]);
+      CHECK(std::abs(el.level(mid[e]) - 1) < 1e-14);
+      double dt = std::abs(el.parameter(B) - el.parameter(A));
+      if (dt > pi) dt = 2 * pi - dt;
+      const Vec<2> a = A - mid[e], b = B - mid[e];
+      const double bulge = 4.0 / 3.0 * 0.5 * std::abs(a[0] * b[1] - a[1] * b[0]);
+      const double ab = el.a * el.b;
+      CHECK(bulge == Approx(ab * 4.0 / 3.0 * std::sin(dt / 2) * (1 - std::cos(dt / 2))).epsilon(1e-9));
+      polygon_defect += ab * (dt - std::sin(dt)) / 2;
+      quadratic_defect += ab * (dt - std::sin(dt)) / 2 - bulge;
+    }
+  // the polygons miss exactly the elliptic segments
+  CHECK(holes + polygon_defect == Approx(pi * (e1.a * e1.b + e2.a * e2.b)).epsilon(1e-12));
+  INFO("area missed: polygons " << polygon_defect << ", quadratic boundary " << quadratic_defect);
+  CHECK(std::abs(quadratic_defect) < 1e-3 * polygon_defect);  // O(dt^5) against O(dt^3) per edge
+  // an ellipse is a hole only; overlapping ellipses are refused by name
+  auto mesh = [](const Domain2D& d) { return [=] { (void)generate_mesh(d, MesherOptions{uniform_size(0.2)}); }; };
+  CHECK(invalid_parameter(mesh({Ellipse{Vec<2>::Zero(), 2, 1, 0, 1}, {}})) == "outer");
+  CHECK(invalid_parameter(mesh({box, {Ellipse{Vec<2>::Zero(), 0.5, 0, 0, 1}}})) == "holes[0].b");
+  CHECK(invalid_parameter(mesh({box, {e1, Ellipse{Vec<2>(-0.3, 0.1), 0.3, 0.1, 0, 3}}})) == "holes[1]");
+  CHECK(invalid_parameter(mesh({box, {Ellipse{Vec<2>(1.5, 0), 0.6, 0.1, 0, 3}}})) == "holes[0]");  // crosses the wall
+}
+
 TEST_CASE("mesher rejects bad input naming the parameter", "[mesh][mesher]") {
   const Polyline box{{Vec<2>(0, 0), Vec<2>(2, 0), Vec<2>(2, 2), Vec<2>(0, 2)}, 1};
   const MesherOptions ok{uniform_size(0.2)};

@@ -11,7 +11,8 @@
 ///     of the input mesh, carried to new nodes by averaging). Edges with (L - E) / E > T
 ///     are split at their midpoint, longest (relative) first; repeated until none is left.
 ///     A boundary edge on a curve is split at the projection of its midpoint on the curve
-///     (on a circle: the arc midpoint), and both halves keep the edge's tag.
+///     (on a circle: the arc midpoint; on an ellipse: along the ray from its centre), and
+///     both halves keep the edge's tag.
 ///  2. Collapses. Edges with (L - E) / E < -T, shortest (relative) first, are collapsed onto
 ///     one end point (the other one is removed; the paper keeps an end point too). Refused
 ///     unless: the removed node is free (not a corner, see below), a boundary node is
@@ -82,8 +83,9 @@
 
 namespace alefsi {
 
-/// A tagged boundary curve: a Circle (a body or a circular wall) or a closed Polyline
-/// (walls), the types of mesher2d.hpp.
+/// A tagged boundary curve: a Circle (a body or a circular wall), an Ellipse (a body) or a
+/// closed Polyline (walls), the types of mesher2d.hpp. Nodes slide along circles and
+/// ellipses by radial projection.
 using BoundaryCurve = Boundary2D;
 
 struct AdaptOptions {
@@ -185,6 +187,8 @@ class AdaptMesh2D {
       Real d = std::numeric_limits<Real>::infinity();
       if (const Circle* c = std::get_if<Circle>(&curves_[i])) {
         if (c->tag == tag) d = std::abs((p - c->centre).norm() - c->radius);
+      } else if (const Ellipse* e = std::get_if<Ellipse>(&curves_[i])) {
+        if (e->tag == tag) d = (e->radial_projection(p) - p).norm();
       } else {
         const Polyline& P = std::get<Polyline>(curves_[i]);
         for (std::size_t s = 0; s < P.points.size(); ++s)
@@ -200,6 +204,8 @@ class AdaptMesh2D {
       const Real n = d.norm();
       return n > 0 ? Vec<2>(c->centre + c->radius / n * d) : p;
     }
+    if (const Ellipse* e = std::get_if<Ellipse>(&curves_[curve]))
+      return p != e->centre ? e->radial_projection(p) : p;
     const Polyline& P = std::get<Polyline>(curves_[curve]);
     Vec<2> best = p;
     Real bd = std::numeric_limits<Real>::infinity();

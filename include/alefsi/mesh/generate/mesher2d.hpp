@@ -2,21 +2,21 @@
 /// \file mesh/generate/mesher2d.hpp
 /// Built-in unstructured triangle mesher for 2D domains with holes (bodies).
 ///
-/// Domain: an outer closed boundary (polyline or circle) and holes (polylines or circles),
-/// each with a boundary tag (polylines may tag each side separately). Mesh size: a user
+/// Domain: an outer closed boundary (polyline or circle) and holes (polylines, circles or
+/// ellipses), each with a boundary tag (polylines may tag each side separately). Mesh size: a user
 /// size function h(x), e.g. `graded_size` (h_body at the bodies, growing linearly with the
 /// distance to h_far) or `uniform_size`.
 ///
 /// Algorithm: the boundaries are discretised with a node spacing following h (nodes on a
-/// circle are exactly c + r (cos t, sin t)); the points are Delaunay-triangulated
+/// circle are exactly c + r (cos t, sin t), on an ellipse c + R (a cos t, b sin t)); the points are Delaunay-triangulated
 /// (Bowyer-Watson, inside a super-triangle); the boundary segments are recovered by flips
 /// (Sloan) to a constrained Delaunay triangulation; the exterior and the holes are removed
 /// by parity; then Ruppert/Chew refinement: encroached boundary segments are split (at the
-/// midpoint; on a circle at the arc midpoint, so the new node lies on the circle; next to a
-/// small input angle at a power-of-two distance from the corner, "concentric shells"), bad
-/// triangles (an angle below min_angle_deg, or circumradius above h(centroid) / sqrt(3))
-/// get their circumcentre inserted, unless it lies behind or encroaches a segment, which
-/// is then split instead. See detail/cdt2d.hpp.
+/// midpoint; on a circle or an ellipse at the parameter midpoint, so the new node lies on the
+/// curve; next to a small input angle at a power-of-two distance from the corner,
+/// "concentric shells"), bad triangles (an angle below min_angle_deg, or circumradius above
+/// h(centroid) / sqrt(3)) get their circumcentre inserted, unless it lies behind or
+/// encroaches a segment, which is then split instead. See detail/cdt2d.hpp.
 ///
 /// Guarantees: every triangle is positively oriented (insertions are checked with exact
 /// predicates before they are committed); every angle is >= min_angle_deg (default 25)
@@ -66,6 +66,37 @@ struct Circle {
   int tag = 0;
 };
 
+/// An ellipse boundary, x(t) = centre + R(angle) (a cos t, b sin t): semi-axis `a` along the
+/// direction at `angle` (radians from the x axis), `b` across it. A hole only: an elliptic body.
+struct Ellipse {
+  Vec<2> centre = Vec<2>::Zero();
+  Real a = 1, b = 1;
+  Real angle = 0;
+  int tag = 0;
+
+  /// The point at parameter t.
+  Vec<2> at(Real t) const {
+    const Real c = std::cos(angle), s = std::sin(angle), u = a * std::cos(t), v = b * std::sin(t);
+    return centre + Vec<2>(c * u - s * v, s * u + c * v);
+  }
+  /// The ellipse's level function: sqrt((y_1 / a)^2 + (y_2 / b)^2) with y = R^T (x - centre);
+  /// 1 on the curve, below inside.
+  Real level(const Vec<2>& x) const {
+    const Real c = std::cos(angle), s = std::sin(angle);
+    const Vec<2> d = x - centre;
+    return std::hypot((c * d[0] + s * d[1]) / a, (-s * d[0] + c * d[1]) / b);
+  }
+  /// The parameter t of the curve's point on the ray from the centre through x (x != centre).
+  Real parameter(const Vec<2>& x) const {
+    const Real c = std::cos(angle), s = std::sin(angle);
+    const Vec<2> d = x - centre;
+    return std::atan2((-s * d[0] + c * d[1]) / b, (c * d[0] + s * d[1]) / a);
+  }
+  /// The curve's point on the ray from the centre through x (x != centre): a projection onto
+  /// the ellipse that is smooth in x and exact on the curve (not the closest point).
+  Vec<2> radial_projection(const Vec<2>& x) const { return centre + (x - centre) / level(x); }
+};
+
 /// A closed polyline (the last point connects to the first); segment i runs from
 /// points[i] to points[i + 1]. `segment_tags`, if given, tags each segment separately.
 struct Polyline {
@@ -74,10 +105,10 @@ struct Polyline {
   std::vector<int> segment_tags = {};
 };
 
-using Boundary2D = std::variant<Polyline, Circle>;
+using Boundary2D = std::variant<Polyline, Circle, Ellipse>;
 
 /// The region inside `outer` and outside every hole. Holes must lie strictly inside the
-/// outer boundary and must not touch each other.
+/// outer boundary and must not touch each other; an Ellipse is a hole only.
 struct Domain2D {
   Boundary2D outer;
   std::vector<Boundary2D> holes = {};
@@ -199,7 +230,26 @@ inline std::vector<XY> polyline_xy(const Polyline& p) {
   return out;
 }
 
+/// A polygon of n points containing the ellipse: the points of the ellipse scaled by
+/// 1 / cos(pi / n) about its centre at equal parameter steps (the affine image of a polygon
+/// circumscribed about the unit circle).
+inline Polyline circumscribed_polygon(const Ellipse& e, int n = 256) {
+  Ellipse big = e;
+  big.a /= std::cos(std::numbers::pi / n), big.b /= std::cos(std::numbers::pi / n);
+  Polyline p;
+  p.tag = e.tag;
+  for (int i = 0; i < n; ++i) p.points.push_back(big.at(2 * std::numbers::pi * i / n));
+  return p;
+}
+
 inline void validate_boundary(const Boundary2D& b, const std::string& name) {
+  if (const Ellipse* e = std::get_if<Ellipse>(&b)) {
+    ALEFSI_CHECK_ARG(finite(e->centre), name + ".centre", "must be finite");
+    ALEFSI_CHECK_ARG(e->a > 0 && std::isfinite(e->a), name + ".a", "must be positive and finite, got ", e->a);
+    ALEFSI_CHECK_ARG(e->b > 0 && std::isfinite(e->b), name + ".b", "must be positive and finite, got ", e->b);
+    ALEFSI_CHECK_ARG(std::isfinite(e->angle), name + ".angle", "must be finite, got ", e->angle);
+    return;
+  }
   if (const Circle* c = std::get_if<Circle>(&b)) {
     ALEFSI_CHECK_ARG(finite(c->centre), name + ".centre", "must be finite");
     ALEFSI_CHECK_ARG(c->radius > 0 && std::isfinite(c->radius), name + ".radius",
@@ -238,8 +288,11 @@ inline void validate_boundary(const Boundary2D& b, const std::string& name) {
   ALEFSI_CHECK_ARG(polygon_area(q) != 0, name + ".points", "polyline encloses zero area");
 }
 
-/// Do the two (validated) boundaries' closed regions overlap or touch?
+/// Do the two (validated) boundaries' closed regions overlap or touch? (Ellipses: their
+/// circumscribed 256-gons, a conservative answer.)
 inline bool regions_meet(const Boundary2D& A, const Boundary2D& B) {
+  if (const Ellipse* e = std::get_if<Ellipse>(&A)) return regions_meet(Boundary2D(circumscribed_polygon(*e)), B);
+  if (const Ellipse* e = std::get_if<Ellipse>(&B)) return regions_meet(A, Boundary2D(circumscribed_polygon(*e)));
   const Circle* ca = std::get_if<Circle>(&A);
   const Circle* cb = std::get_if<Circle>(&B);
   if (ca && cb) return (ca->centre - cb->centre).norm() <= ca->radius + cb->radius;
@@ -259,8 +312,10 @@ inline bool regions_meet(const Boundary2D& A, const Boundary2D& B) {
   return point_in_polygon(pa[0], pb) >= 0 || point_in_polygon(pb[0], pa) >= 0;
 }
 
-/// Is the (validated) hole strictly inside the outer boundary?
+/// Is the (validated) hole strictly inside the (non-ellipse) outer boundary? (An elliptic
+/// hole: its circumscribed 256-gon, a conservative answer.)
 inline bool strictly_inside(const Boundary2D& hole, const Boundary2D& outer) {
+  if (const Ellipse* e = std::get_if<Ellipse>(&hole)) return strictly_inside(Boundary2D(circumscribed_polygon(*e)), outer);
   const Circle* ch = std::get_if<Circle>(&hole);
   if (const Circle* co = std::get_if<Circle>(&outer)) {
     if (ch) return (ch->centre - co->centre).norm() + ch->radius < co->radius;
@@ -293,6 +348,8 @@ inline void validate_domain(const Domain2D& dom, const MesherOptions& opt) {
                    "must be in (0, 33] (Ruppert refinement need not terminate above), got ", opt.min_angle_deg);
   ALEFSI_CHECK_ARG(opt.max_points >= 3, "max_points", "must be >= 3");
   validate_boundary(dom.outer, "outer");
+  ALEFSI_CHECK_ARG(!std::holds_alternative<Ellipse>(dom.outer), "outer",
+                   "an ellipse is supported as a hole (a body) only; give the outer boundary as a Polyline or Circle");
   for (std::size_t i = 0; i < dom.holes.size(); ++i) {
     const std::string name = boundary_name(static_cast<int>(i));
     validate_boundary(dom.holes[i], name);
@@ -302,10 +359,11 @@ inline void validate_domain(const Domain2D& dom, const MesherOptions& opt) {
   }
 }
 
-/// Node parameters s in [0, 1) along a curve of the given length so that the spacing
-/// follows h: n = max(min_pieces, ceil(integral of 1/h)) pieces of equal integral of 1/h.
-template <class At>
-std::vector<double> distribute(const At& at, double length, int min_pieces, const SizeFunction& h,
+/// Node parameters s in [0, 1) along a curve x(s) with speed |dx/ds| = speed(s) so that the
+/// spacing follows h: n = max(min_pieces, ceil(integral of 1/h)) pieces of equal integral of
+/// 1/h (arc length).
+template <class At, class Speed>
+std::vector<double> distribute(const At& at, const Speed& speed, int min_pieces, const SizeFunction& h,
                                const std::string& where) {
   std::vector<double> cum;
   std::size_t K = 64;
@@ -319,7 +377,7 @@ std::vector<double> distribute(const At& at, double length, int min_pieces, cons
       if (!(hv > 0) || !std::isfinite(hv))
         throw InvalidArgument("size", concat("must be positive and finite, got ", hv, " at (", p.x, ", ", p.y,
                                              ") on ", where));
-      const double w = length / hv;
+      const double w = speed(double(j) / double(K)) / hv;
       if (j > 0) cum[j] = cum[j - 1] + 0.5 * (w + w_prev) / double(K);
       w_prev = w;
     }
@@ -341,6 +399,22 @@ std::vector<double> distribute(const At& at, double length, int min_pieces, cons
   return s;
 }
 
+/// The same along a curve of constant speed (a straight segment, a circle): length = speed.
+template <class At>
+std::vector<double> distribute(const At& at, double length, int min_pieces, const SizeFunction& h,
+                               const std::string& where) {
+  return distribute(at, [length](double) { return length; }, min_pieces, h, where);
+}
+
+/// The conic of a Circle or Ellipse boundary as the triangulator's loop (not a conic: a
+/// polyline loop).
+inline CdtLoop conic_loop(const Boundary2D& b) {
+  if (const Circle* c = std::get_if<Circle>(&b)) return {true, to_xy(c->centre), c->radius, c->radius, 1, 0};
+  if (const Ellipse* e = std::get_if<Ellipse>(&b))
+    return {true, to_xy(e->centre), e->a, e->b, std::cos(e->angle), std::sin(e->angle)};
+  return {false, {0, 0}, 0, 0, 1, 0};
+}
+
 }  // namespace detail
 
 /// Triangulates the domain. Throws InvalidArgument (naming the parameter) for bad input,
@@ -354,24 +428,29 @@ inline Mesh<2> generate_mesh(const Domain2D& domain, const MesherOptions& option
   // ---- boundary discretisation ------------------------------------------------------
   std::vector<const Boundary2D*> loops{&domain.outer};
   for (const auto& b : domain.holes) loops.push_back(&b);
-  std::vector<std::vector<double>> circle_t(loops.size());  // node angles of circle loops
-  for (std::size_t l = 0; l < loops.size(); ++l)
-    if (const Circle* c = std::get_if<Circle>(loops[l])) {
-      const XY cc = detail::to_xy(c->centre);
-      const double r = c->radius;
-      auto at = [&](double s) { return XY{cc.x + r * std::cos(two_pi * s), cc.y + r * std::sin(two_pi * s)}; };
-      for (double s : detail::distribute(at, two_pi * r, 8, h, detail::boundary_name(int(l) - 1)))
-        circle_t[l].push_back(two_pi * s);
+  std::vector<detail::CdtLoop> conic(loops.size());
+  std::vector<std::vector<double>> circle_t(loops.size());  // node parameters of conic loops
+  for (std::size_t l = 0; l < loops.size(); ++l) {
+    conic[l] = detail::conic_loop(*loops[l]);
+    const detail::CdtLoop& C = conic[l];
+    if (!C.circle) continue;
+    auto at = [&](double s) { return C.at(two_pi * s); };
+    const std::string where = detail::boundary_name(int(l) - 1);
+    std::vector<double> s;
+    if (std::holds_alternative<Circle>(*loops[l])) {
+      s = detail::distribute(at, two_pi * C.ra, 8, h, where);
+    } else {
+      auto speed = [&](double u) { return two_pi * std::hypot(C.ra * std::sin(two_pi * u), C.rb * std::cos(two_pi * u)); };
+      s = detail::distribute(at, speed, 8, h, where);
     }
-  auto circle_node = [](const Circle& c, double t) {
-    return XY{c.centre[0] + c.radius * std::cos(t), c.centre[1] + c.radius * std::sin(t)};
-  };
+    for (double u : s) circle_t[l].push_back(two_pi * u);
+  }
   // an outer circle's chords must pass outside every hole: refine the offending arcs
   if (const Circle* co = std::get_if<Circle>(&domain.outer)) {
     std::vector<XY> hole_pts;
     for (std::size_t l = 1; l < loops.size(); ++l) {
-      if (const Circle* c = std::get_if<Circle>(loops[l])) {
-        for (double t : circle_t[l]) hole_pts.push_back(circle_node(*c, t));
+      if (conic[l].circle) {
+        for (double t : circle_t[l]) hole_pts.push_back(conic[l].at(t));
       } else {
         for (const auto& p : std::get<Polyline>(*loops[l]).points) hole_pts.push_back(detail::to_xy(p));
       }
@@ -388,7 +467,7 @@ inline Mesh<2> generate_mesh(const Domain2D& domain, const MesherOptions& option
         const std::size_t k = static_cast<std::size_t>(std::upper_bound(T.begin(), T.end(), phi) - T.begin()) - 1;
         for (std::size_t d = n - 1; d <= n + 1; ++d) {
           const std::size_t i = (k + d) % n;
-          const XY a = circle_node(*co, T[i]), b = circle_node(*co, T[(i + 1) % n]);
+          const XY a = conic[0].at(T[i]), b = conic[0].at(T[(i + 1) % n]);
           if (!(detail::orient2d(a, b, p) > 0)) split[i] = 1, any = true;
         }
       }
@@ -410,15 +489,17 @@ inline Mesh<2> generate_mesh(const Domain2D& domain, const MesherOptions& option
   int input_edges = 0;
   for (std::size_t l = 0; l < loops.size(); ++l) {
     const int li = static_cast<int>(l);
-    if (const Circle* c = std::get_if<Circle>(loops[l])) {
-      cdt.loops.push_back({true, detail::to_xy(c->centre), c->radius});
+    if (conic[l].circle) {
+      cdt.loops.push_back(conic[l]);
+      const int tag = std::holds_alternative<Circle>(*loops[l]) ? std::get<Circle>(*loops[l]).tag
+                                                                : std::get<Ellipse>(*loops[l]).tag;
       const std::vector<double>& T = circle_t[l];
       const Index first = static_cast<Index>(cdt.pts.size());
-      for (double t : T) cdt.add_vertex(circle_node(*c, t), -1, -1);
+      for (double t : T) cdt.add_vertex(conic[l].at(t), -1, -1);
       const Index n = static_cast<Index>(T.size());
       for (Index i = 0; i < n; ++i) {
         detail::CdtSeg s;
-        s.a = first + i, s.b = first + (i + 1) % n, s.loop = li, s.tag = c->tag;
+        s.a = first + i, s.b = first + (i + 1) % n, s.loop = li, s.tag = tag;
         s.ta = T[static_cast<std::size_t>(i)];
         s.tb = i + 1 < n ? T[static_cast<std::size_t>(i + 1)] : two_pi;
         cdt.segs.push_back(s);
@@ -426,7 +507,7 @@ inline Mesh<2> generate_mesh(const Domain2D& domain, const MesherOptions& option
       continue;
     }
     const Polyline& P = std::get<Polyline>(*loops[l]);
-    cdt.loops.push_back({false, {0, 0}, 0});
+    cdt.loops.push_back(conic[l]);
     const std::vector<XY> q = detail::polyline_xy(P);
     const std::size_t n = q.size();
     const bool ccw = detail::polygon_area(q) > 0;
@@ -544,7 +625,8 @@ inline Real min_angle_deg(const Mesh<2>& mesh) {
 }
 
 /// P2 helper: for every mesh edge (indexed as mesh.edges()), its midpoint, or, for a
-/// boundary edge on a circle of the domain, the point of the circle at the mid angle.
+/// boundary edge on a circle or an ellipse of the domain, the point of the curve at the mid
+/// parameter.
 inline std::vector<Vec<2>> curved_edge_midpoints(const Mesh<2>& mesh, const Domain2D& domain) {
   std::vector<Vec<2>> mid(static_cast<std::size_t>(mesh.n_edges()));
   for (Index e = 0; e < mesh.n_edges(); ++e) mid[e] = 0.5 * (mesh.node(mesh.edge(e)[0]) + mesh.node(mesh.edge(e)[1]));
@@ -552,7 +634,10 @@ inline std::vector<Vec<2>> curved_edge_midpoints(const Mesh<2>& mesh, const Doma
   if (const Circle* c = std::get_if<Circle>(&domain.outer)) circles.push_back(c);
   for (const auto& b : domain.holes)
     if (const Circle* c = std::get_if<Circle>(&b)) circles.push_back(c);
-  if (circles.empty()) return mid;
+  std::vector<const Ellipse*> ellipses;
+  for (const auto& b : domain.holes)
+    if (const Ellipse* e = std::get_if<Ellipse>(&b)) ellipses.push_back(e);
+  if (circles.empty() && ellipses.empty()) return mid;
   auto on = [](const Circle& c, const Vec<2>& x) {
     return std::abs((x - c.centre).norm() - c.radius) <= 1e-10 * (c.radius + c.centre.norm());
   };
@@ -564,6 +649,19 @@ inline std::vector<Vec<2>> curved_edge_midpoints(const Mesh<2>& mesh, const Doma
       if (mesh.edge(e) == fv) edge = e;
     if (edge < 0) continue;
     const Vec<2>&a = mesh.node(fv[0]), &b = mesh.node(fv[1]);
+    const Ellipse* ell = nullptr;
+    for (const Ellipse* e : ellipses)
+      if (std::abs(e->level(a) - 1) <= 1e-10 && std::abs(e->level(b) - 1) <= 1e-10 &&
+          (!ell || e->tag == mesh.facet_tag(f)))
+        ell = e;
+    if (ell) {
+      const Real ta = ell->parameter(a);
+      Real dt = ell->parameter(b) - ta;
+      if (dt > std::numbers::pi) dt -= 2 * std::numbers::pi;
+      if (dt < -std::numbers::pi) dt += 2 * std::numbers::pi;
+      mid[edge] = ell->at(ta + 0.5 * dt);
+      continue;
+    }
     const Circle* best = nullptr;
     for (const Circle* c : circles)
       if (on(*c, a) && on(*c, b) && (!best || c->tag == mesh.facet_tag(f))) best = c;

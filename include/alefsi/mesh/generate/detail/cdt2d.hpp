@@ -16,11 +16,11 @@
 ///  - Segment recovery by edge flips (Sloan), then Lawson flips to the CDT.
 ///  - Exterior removal by a parity flood fill across constrained edges.
 ///  - Refinement: encroached segments (an apex inside the diametral circle) are split first
-///    (straight: midpoint, or a power-of-two distance from a small-angle corner; circle
-///    arcs: the arc midpoint, so the node lies on the circle); then bad triangles (radius-
-///    edge ratio above 1 / (2 sin theta_min), or circumradius above h / sqrt(3)) get their
-///    circumcentre, located by a straight walk; a circumcentre behind a segment or
-///    encroaching one is rejected in favour of splitting that segment.
+///    (straight: midpoint, or a power-of-two distance from a small-angle corner; arcs of a
+///    circle or an ellipse: the parameter midpoint, so the node lies on the curve); then bad
+///    triangles (radius-edge ratio above 1 / (2 sin theta_min), or circumradius above
+///    h / sqrt(3)) get their circumcentre, located by a straight walk; a circumcentre behind
+///    a segment or encroaching one is rejected in favour of splitting that segment.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -38,11 +38,19 @@
 
 namespace alefsi::detail {
 
-/// A boundary loop: a circle (arc parameters on its segments) or a polyline.
+/// A boundary loop: a conic (a circle or an ellipse, with parameters t on its segments:
+/// x(t) = centre + R (ra cos t, rb sin t), R the rotation by the angle with cosine cs and sine
+/// sn) or a polyline.
 struct CdtLoop {
-  bool circle = false;
+  bool circle = false;  ///< a conic: the segments carry parameters
   XY centre{0, 0};
-  double radius = 0;
+  double ra = 0, rb = 0;  ///< semi-axes (equal on a circle)
+  double cs = 1, sn = 0;
+  /// The point at parameter t (on a circle: centre + r (cos t, sin t), to the last bit).
+  XY at(double t) const {
+    const double u = ra * std::cos(t), v = rb * std::sin(t);
+    return {centre.x + (cs * u - sn * v), centre.y + (sn * u + cs * v)};
+  }
 };
 
 /// A boundary segment (subsegment of an input boundary).
@@ -50,8 +58,8 @@ struct CdtSeg {
   Index a = -1, b = -1;
   int loop = -1;
   int tag = 0;
-  double ta = 0, tb = 0;  ///< angles of a and b on a circle loop (|tb - ta| < pi)
-  int input_edge = -1;    ///< input polyline edge (-1 on circles)
+  double ta = 0, tb = 0;  ///< parameters of a and b on a conic loop (|tb - ta| < pi)
+  int input_edge = -1;    ///< input polyline edge (-1 on conics)
 };
 
 /// An input polyline vertex with its domain-side angle and incident input edges.
@@ -709,9 +717,8 @@ class Cdt2D {
     XY m;
     double tm = 0;
     if (loops[sg.loop].circle) {
-      const CdtLoop& L = loops[sg.loop];
       tm = 0.5 * (sg.ta + sg.tb);
-      m = {L.centre.x + L.radius * std::cos(tm), L.centre.y + L.radius * std::sin(tm)};
+      m = loops[sg.loop].at(tm);
     } else {
       const int ca = v_corner[sg.a], cb = v_corner[sg.b];
       const bool sa = ca >= 0 && corners[ca].small, sb = cb >= 0 && corners[cb].small;

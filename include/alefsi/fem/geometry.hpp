@@ -137,8 +137,12 @@ class QuadraticGeometry {
 
   /// The point of edge e when the mesh nodes are at X (one position per node).
   Vec<D> edge_point(Index e, const std::vector<Vec<D>>& X) const {
+    if (!moved_[std::size_t(e)]) {  // the midpoint, without the frame (most edges)
+      const auto& ev = mesh_->edge(e);
+      return 0.5 * (X[std::size_t(ev[0])] + X[std::size_t(ev[1])]);
+    }
     const Frame F = frame(e, X);
-    return moved_[std::size_t(e)] ? Vec<D>(F.origin + F.axes * coef_[std::size_t(e)]) : F.origin;
+    return F.origin + F.axes * coef_[std::size_t(e)];
   }
   /// The velocity of every edge point when the mesh nodes, at their current positions, move at
   /// V (one velocity per node): the derivative of the frame rule; the midpoint average on

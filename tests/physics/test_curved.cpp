@@ -12,10 +12,12 @@
 
 #include "alefsi/fem/geometry.hpp"
 #include "alefsi/fem/norms.hpp"
+#include "alefsi/mesh/generate/mesher2d.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
 #include "alefsi/mesh/io/gmsh.hpp"
 #include "alefsi/physics/navier_stokes.hpp"
 #include "alefsi/physics/stokes.hpp"
+#include "alefsi/scenes/jeffery.hpp"
 #include "alefsi/sim/ale_flow.hpp"
 #include "alefsi/sim/driver.hpp"
 
@@ -507,6 +509,47 @@ TEST_CASE("a free sphere turning in a fixed one on curved cells: the torque law 
     std::cout << "sphere Couette, gmsh shell h = 0." << name + 1 << ": relative error in w straight " << s << ", curved "
               << c << "\n";
     CHECK(c < 0.15 * s);
+  }
+}
+
+TEST_CASE("a free ellipse in simple shear turns on Jeffery's orbit (curved cells)", "[curved][bodies][convergence]") {
+  // Jeffery (1922), in 2D: w(phi) = -(a^2 sin^2 phi + b^2 cos^2 phi) / (a^2 + b^2), period
+  // T = 2 pi (a^2 + b^2) / (a b). In a circular container the form A sin^2 + B cos^2 is exact
+  // too (the wall's shear is a rigid rotation at -1/2, which the body follows exactly, plus a
+  // strain whose torque turns with the body as cos 2 phi), so w(pi/4) = -1/2 and
+  // w(pi/8) = (w(0) + w(pi/2)) / 2 + (w(0) - w(pi/2)) sqrt(2) / 4 hold on every container, and
+  // T = 2 pi / sqrt(w(0) w(pi/2)). The container's wall reflects the stresslet: T converges to
+  // Jeffery's at O((a / L)^2) (measured factors 4.1, 4.0, 3.8 for L = 8 .. 64), so L = 16 and 32
+  // extrapolate to it. Measured at b = 0.5: T / T_J - 1 = 4.02e-3, 1.01e-3, extrapolated 9e-6.
+  // (scenes/jeffery.hpp: Stokes, the body massless; h = 0.1 b at the ellipse, 20 cells per b.)
+  for (const Real b : {0.5, 0.25}) {
+    scenes::Jeffery scene{.b = b, .h_body = 0.1 * b};
+    const Real wj0 = scene.jeffery_spin(0), wj90 = scene.jeffery_spin(pi / 2), Tj = scene.jeffery_period();
+    Real T[2];
+    for (int k = 0; k < 2; ++k) {
+      const Real L = 16 << k;
+      scene.container = L;
+      const Real w0 = scene.spin(0), w90 = scene.spin(pi / 2), w45 = scene.spin(pi / 4), w22 = scene.spin(pi / 8);
+      T[k] = 2 * pi / std::sqrt(w0 * w90);
+      std::cout << "ellipse b/a = " << b << ", container L = " << L << ": w(0) " << w0 << " (Jeffery " << wj0
+                << "), w(pi/2) " << w90 << " (" << wj90 << "), w(pi/4) + 1/2 = " << w45 + 0.5 << ", period "
+                << T[k] << " (Jeffery " << Tj << ", " << T[k] / Tj - 1 << ")\n";
+      CHECK(std::abs(w45 + 0.5) < 1e-5);
+      CHECK(std::abs(w22 - ((w0 + w90) / 2 + (w0 - w90) * std::sqrt(2.0) / 4)) < 1e-5);
+    }
+    const Real factor = (T[0] / Tj - 1) / (T[1] / Tj - 1), T_ext = (4 * T[1] - T[0]) / 3;
+    std::cout << "  container error factor L 16 -> 32: " << factor << "; extrapolated period " << T_ext << ", "
+              << T_ext / Tj - 1 << " from Jeffery's\n";
+    CHECK(factor == Approx(4).margin(0.3));
+    CHECK(std::abs(T_ext / Tj - 1) < 1e-4);
+  }
+  // straight cells (the ellipse a polygon) against curved ones on the same meshes, L = 32
+  for (const Real b : {0.5, 0.25}) {
+    scenes::Jeffery curved{.b = b, .h_body = 0.1 * b}, straight = curved;
+    straight.curved = false;
+    const Real Ts = 2 * pi / std::sqrt(straight.spin(0) * straight.spin(pi / 2));
+    const Real Tc = 2 * pi / std::sqrt(curved.spin(0) * curved.spin(pi / 2));
+    std::cout << "  b/a = " << b << ", L = 32: period on straight cells / on curved cells - 1 = " << Ts / Tc - 1 << "\n";
   }
 }
 

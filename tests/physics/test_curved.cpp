@@ -542,14 +542,10 @@ TEST_CASE("a free ellipse in simple shear turns on Jeffery's orbit (curved cells
               << T_ext / Tj - 1 << " from Jeffery's\n";
     CHECK(factor == Approx(4).margin(0.3));
     CHECK(std::abs(T_ext / Tj - 1) < 1e-4);
-  }
-  // straight cells (the ellipse a polygon) against curved ones on the same meshes, L = 32
-  for (const Real b : {0.5, 0.25}) {
-    scenes::Jeffery curved{.b = b, .h_body = 0.1 * b}, straight = curved;
-    straight.curved = false;
-    const Real Ts = 2 * pi / std::sqrt(straight.spin(0) * straight.spin(pi / 2));
-    const Real Tc = 2 * pi / std::sqrt(curved.spin(0) * curved.spin(pi / 2));
-    std::cout << "  b/a = " << b << ", L = 32: period on straight cells / on curved cells - 1 = " << Ts / Tc - 1 << "\n";
+    // straight cells (the ellipse a polygon) against the curved ones on the same meshes, L = 32
+    scene.curved = false;
+    const Real Ts = 2 * pi / std::sqrt(scene.spin(0) * scene.spin(pi / 2));
+    std::cout << "  L = 32: period on straight cells / on curved cells - 1 = " << Ts / T[1] - 1 << "\n";
   }
 }
 

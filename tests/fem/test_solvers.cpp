@@ -24,8 +24,11 @@
 #include "alefsi/physics/mesh_motion.hpp"
 #include "alefsi/physics/stokes.hpp"
 #include "alefsi/sim/ale_flow.hpp"
+#include "../support/stokes_systems.hpp"
 
 using namespace alefsi;
+using alefsi::testing::cavity3d;
+using alefsi::testing::SaddleSystem;
 
 namespace {
 
@@ -300,39 +303,6 @@ TEST_CASE("mesh velocity with factorisation reuse: the same velocities as a fact
 // ---- the iterative path for 3D (la/amg.hpp, la/krylov.hpp) ----------------------------------
 
 namespace {
-
-struct SaddleSystem {
-  SparseMatrix A;
-  VecX b;
-  SaddlePointBlocks blocks;
-};
-
-// 3D lid-driven cavity on box_mesh(n, n, n): every boundary velocity fixed (lid z = 1:
-// (1, 0, 0)), pressure DOF 0 pinned, mu = 1; b = -r at the zero field.
-template <class Pair>
-SaddleSystem cavity3d(int n) {
-  const Mesh<3> mesh = box_mesh(n, n, n);
-  MixedSpace<3, Pair> space(mesh);
-  StokesKernel<3, Pair> kernel(space, 1.0);
-  DofConstraints cons(space.n_field());
-  const auto& vel = space.velocity();
-  std::vector<char> done(vel.n_dofs(), 0);
-  for (int t : {tags::zmax, 1, 2, 3, 4, 5})
-    for (Index i : vel.boundary_dofs(t)) {
-      if (done[i]) continue;
-      done[i] = 1;
-      for (int k = 0; k < 3; ++k) cons.fix(space.velocity_field(i, k), (t == tags::zmax && k == 0) ? 1.0 : 0.0);
-    }
-  cons.fix(space.pressure_field(0), 0.0);
-  cons.finalize();
-  Assembler<MixedSpace<3, Pair>::n_local> asmb(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
-  SaddleSystem s;
-  VecX r;
-  asmb.assemble(kernel, cons.expand(VecX::Zero(cons.n_unknowns())), &s.A, &r);
-  s.b = -r;
-  s.blocks = saddle_point_blocks(space, cons, 1.0);
-  return s;
-}
 
 template <class Pair>
 int krylov_iterations(const SaddleSystem& s, KrylovOptions opt, bool blocks) {

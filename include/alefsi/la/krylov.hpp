@@ -94,32 +94,14 @@ class SaddlePointGmres {
 
   /// Finds the split [u | p | z] (from the blocks, or from the diagonal's sign).
   void analyze(const SparseMatrix& A) {
-    ALEFSI_CHECK_ARG(A.rows() == A.cols(), "A", "must be square");
     n_ = A.rows();
+    const SaddlePointSplit split = saddle_point_split(A, blocks_ ? &*blocks_ : nullptr, name);
+    nu_ = split.n_velocity, np_ = split.n_pressure, ne_ = split.n_extra;
+    comp_.clear();
     if (blocks_) {
-      np_ = blocks_->n_pressure;
-      ne_ = blocks_->n_extra;
-      nu_ = n_ - np_ - ne_;
-      ALEFSI_CHECK_ARG(nu_ > 0 && np_ > 0 && ne_ >= 0, "A", "size ", n_, " does not match the blocks (", np_,
-                       " pressures, ", ne_, " extras)");
       comp_ = blocks_->velocity_component;
       ALEFSI_CHECK_ARG(comp_.empty() || Index(comp_.size()) == nu_, "blocks.velocity_component",
                        "needs one label per velocity unknown");
-    } else {
-      Index first = -1, last = -1;
-      for (Index j = 0; j < n_; ++j)
-        if (!(A.coeff(j, j) > 0)) {
-          if (first < 0) first = j;
-          last = j;
-        }
-      if (first < 0) throw SolverError(std::string(name) + ": no unknown with a diagonal <= 0: not a saddle-point system");
-      for (Index j = first; j <= last; ++j)
-        if (A.coeff(j, j) > 0)
-          throw SolverError(std::string(name) + ": the unknowns with a diagonal <= 0 are not contiguous; pass the blocks (set_blocks)");
-      nu_ = first;
-      np_ = last + 1 - first;
-      ne_ = n_ - last - 1;
-      comp_.clear();
     }
     if (comp_.empty()) {
       comp_.assign(std::size_t(nu_), 0);

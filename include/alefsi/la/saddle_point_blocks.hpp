@@ -10,6 +10,7 @@
 ///     alefsi::SaddlePointBlocks b = alefsi::saddle_point_blocks(space, cons, mu, rho * a0 / dt);
 #include <array>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "alefsi/core/eigen_sparse.hpp"
@@ -31,6 +32,40 @@ struct SaddlePointBlocks {
   VecX velocity_mass;                   ///< lumped M_u per velocity unknown (for Cahouet–Chabard)
   Real mass_coefficient = 0;            ///< gamma: A_uu holds gamma M_u (rho a_0 / dt; 0: steady)
 };
+
+/// The sizes of the blocks [u | p | z] of a flow system K: from the space's blocks when given
+/// (checked against K's size), otherwise from K's diagonal: the pressures are the contiguous
+/// range of unknowns whose diagonal entry is <= 0 (zero for Taylor–Hood, -C_ii < 0 for GLS; every
+/// velocity and body diagonal is > 0). `solver` names the caller in the errors.
+struct SaddlePointSplit {
+  Index n_velocity = 0, n_pressure = 0, n_extra = 0;
+};
+inline SaddlePointSplit saddle_point_split(const SparseMatrix& K, const SaddlePointBlocks* blocks,
+                                           const char* solver) {
+  ALEFSI_CHECK_ARG(K.rows() == K.cols(), "A", "must be square");
+  const Index n = K.rows();
+  SaddlePointSplit s;
+  if (blocks) {
+    s.n_pressure = blocks->n_pressure, s.n_extra = blocks->n_extra;
+    s.n_velocity = n - s.n_pressure - s.n_extra;
+    ALEFSI_CHECK_ARG(s.n_velocity > 0 && s.n_pressure > 0 && s.n_extra >= 0, "A", "size ", n,
+                     " does not match the blocks (", s.n_pressure, " pressures, ", s.n_extra, " extras)");
+    return s;
+  }
+  Index first = -1, last = -1;
+  for (Index j = 0; j < n; ++j)
+    if (!(K.coeff(j, j) > 0)) {
+      if (first < 0) first = j;
+      last = j;
+    }
+  if (first < 0) throw SolverError(std::string(solver) + ": no unknown with a diagonal <= 0: not a saddle-point system");
+  for (Index j = first; j <= last; ++j)
+    if (K.coeff(j, j) > 0)
+      throw SolverError(std::string(solver) +
+                        ": the unknowns with a diagonal <= 0 are not contiguous; pass the blocks (set_blocks)");
+  s.n_velocity = first, s.n_pressure = last + 1 - first, s.n_extra = n - last - 1;
+  return s;
+}
 
 /// The blocks of the system assembled on `space` through `cons`: pressure mass matrix
 /// (quadrature exact for the pressure element), HRZ-lumped velocity mass (diagonal of the

@@ -10,6 +10,8 @@ cd "$(dirname "$0")/.."
 packages=(cmake ninja-build g++ libeigen3-dev catch2 python3-vtk9 ccache libsuitesparse-dev libopenblas-dev)
 [ "$mode" = example ] && packages+=(python3-matplotlib)  # the example's PNG plots
 [ "$mode" = test ] && packages+=(clang-14 libclang-rt-14-dev)  # libFuzzer: the readers' fuzz tests
+# PETSc with MPI (optional for the library): the suite runs the PETSc solvers on 1 and 2 ranks
+[ "$mode" = test ] && packages+=(petsc-dev libopenmpi-dev openmpi-bin pkg-config)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

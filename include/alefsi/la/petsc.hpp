@@ -1,0 +1,432 @@
+#pragma once
+/// \file la/petsc.hpp
+/// PETSc linear-solver policies, for runs under `mpirun` (optional: link the CMake target
+/// `alefsi::petsc`, defined when pkg-config finds PETSc at configure time; Debian: petsc-dev).
+///
+/// The model is a shared mesh: every rank holds the whole mesh and runs the whole program on it
+/// (assembly with the library's kernels included), and the linear solves are distributed. Each
+/// rank owns a contiguous range of rows of a PETSc AIJ matrix (MPIAIJ on several ranks) and sets
+/// its rows' values from the assembled matrix through PETSc's COO interface: the positions are
+/// found once per sparsity pattern (`analyze`), and each new matrix is a copy of values
+/// (`factorize`), with no per-entry search. `solve(b)` gathers the solution to every rank, so the
+/// rest of the program (Newton updates, bodies, output) runs on the same numbers everywhere.
+/// What this model costs per rank and where it stops: docs/performance.md, "PETSc and MPI".
+///
+///   PetscDirect      MUMPS LU (KSPPREONLY + PCLU); `direct = true`, so the flow's factorisation
+///                    reuse (la/linear_solve.hpp) works with it.
+///   PetscKrylov<D>   GMRES, right-preconditioned (it monitors the true residual), restart 60,
+///                    with PCFIELDSPLIT in Schur form (upper factorisation) on the split
+///                    [u ∪ z | p] of a flow system (la/saddle_point_blocks.hpp: velocities, body
+///                    unknowns, pressures): hypre BoomerAMG on split 0 (velocities and bodies), and
+///                    for the Schur complement either the pressure mass matrix, -(M_p / mu + C),
+///                    with three Chebyshev–Jacobi steps (steady Stokes, when the flow hands over
+///                    its blocks) or PETSc's
+///                    -(B diag(A)^-1 B^T + C) ("selfp", the time-step regime where rho/dt
+///                    dominates) with BoomerAMG.
+///
+/// Both apply their defaults and then read PETSc's options database (KSPSetFromOptions), so every
+/// default can be changed at run time: `-ksp_type fgmres`, `-ksp_rtol 1e-10`, `-ksp_monitor`,
+/// `-ksp_view`, `-pc_fieldsplit_schur_fact_type full`, `-fieldsplit_0_pc_type gamg`,
+/// `-fieldsplit_1_pc_type jacobi`, `-pc_factor_mat_solver_type superlu_dist`. The splits are
+/// named "0" and "1". A prefix (constructor argument) keeps two solvers' options apart.
+///
+///     int main(int argc, char** argv) {
+///       alefsi::PetscSession petsc(argc, argv);          // MPI and PETSc, finalised at exit
+///       using Cfg = alefsi::FlowConfig<3, alefsi::TaylorHood, alefsi::BDF2_BDF2E>
+///                       ::with_solver<alefsi::PetscKrylov<3>>;
+///       alefsi::AleFlow<Cfg> flow(mesh, {rho, mu});      // the same program as serial
+///       ...
+///     }
+///
+/// Solvers must be destroyed before the session ends (declare the session first). PETSc errors
+/// and solves that do not converge throw `SolverError` naming the call, or the reason with the
+/// iterations and the residual.
+#if !__has_include(<petscksp.h>)
+#error "alefsi/la/petsc.hpp needs PETSc: link the CMake target alefsi::petsc (apt install petsc-dev)"
+#endif
+
+#include <petscksp.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <set>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "alefsi/core/eigen_sparse.hpp"
+#include "alefsi/core/error.hpp"
+#include "alefsi/la/assembler.hpp"
+#include "alefsi/la/saddle_point_blocks.hpp"
+#include "alefsi/la/solvers.hpp"
+
+namespace alefsi {
+
+namespace detail {
+/// Throws SolverError naming `call` when a PETSc call failed.
+inline void petsc_check(PetscErrorCode code, const char* call) {
+  if (code == 0) return;
+  const char* text = nullptr;
+  PetscErrorMessage(code, &text, nullptr);
+  throw SolverError(std::string("PETSc: ") + call + " failed (error " + std::to_string(int(code)) + ": " +
+                    (text ? text : "unknown") + ")");
+}
+}  // namespace detail
+
+#define ALEFSI_PETSC(call) ::alefsi::detail::petsc_check((call), #call)
+
+/// MPI and PETSc for the lifetime of a scope: PetscInitialize with the program's arguments (so
+/// that PETSc options on the command line reach the options database), PetscFinalize at the end.
+/// When PETSc is already initialised (by the caller), it leaves it so.
+class PetscSession {
+ public:
+  PetscSession(int& argc, char**& argv, const char* help = nullptr) {
+    PetscBool up = PETSC_FALSE;
+    ALEFSI_PETSC(PetscInitialized(&up));
+    if (up) return;
+    ALEFSI_PETSC(PetscInitialize(&argc, &argv, nullptr, help));
+    owner_ = true;
+  }
+  PetscSession(const PetscSession&) = delete;
+  PetscSession& operator=(const PetscSession&) = delete;
+  ~PetscSession() {
+    if (owner_) PetscFinalize();
+  }
+  /// This process's rank and the number of ranks in PETSC_COMM_WORLD.
+  static int rank() {
+    int r = 0;
+    MPI_Comm_rank(PETSC_COMM_WORLD, &r);
+    return r;
+  }
+  static int size() {
+    int s = 1;
+    MPI_Comm_size(PETSC_COMM_WORLD, &s);
+    return s;
+  }
+
+ private:
+  bool owner_ = false;
+};
+
+namespace detail {
+
+/// The distributed copy of a matrix assembled on every rank, its KSP, and the vectors of a
+/// solve: what PetscDirect and PetscKrylov share.
+class PetscSystem {
+ public:
+  explicit PetscSystem(std::string prefix) : prefix_(std::move(prefix)) {
+    PetscBool up = PETSC_FALSE;
+    PetscInitialized(&up);
+    if (!up) throw SolverError("PETSc solver created before PETSc was initialised (construct an alefsi::PetscSession first)");
+  }
+  PetscSystem(const PetscSystem&) = delete;
+  PetscSystem& operator=(const PetscSystem&) = delete;
+  ~PetscSystem() {
+    PetscBool down = PETSC_FALSE;
+    PetscFinalized(&down);
+    if (down) return;  // PETSc freed everything at PetscFinalize
+    destroy_pattern();
+  }
+
+  /// The rows this rank owns and their entries' positions in the matrix's value array; the
+  /// distributed matrix and vectors, preallocated from the pattern (COO); a new KSP (its type
+  /// and preconditioner are set by the policy at the next factorisation: `take_first`).
+  void analyze(const SparseMatrix& A) {
+    ALEFSI_CHECK_ARG(A.rows() == A.cols(), "A", "must be square, got ", A.rows(), " x ", A.cols());
+    ALEFSI_CHECK_ARG(A.isCompressed(), "A", "must be compressed (makeCompressed)");
+    destroy_pattern();
+    n_ = A.rows();
+    nnz_ = A.nonZeros();
+    PetscInt local = PETSC_DECIDE, global = PetscInt(n_);
+    ALEFSI_PETSC(PetscSplitOwnership(PETSC_COMM_WORLD, &local, &global));
+    PetscInt end = 0;
+    if (MPI_Scan(&local, &end, 1, MPIU_INT, MPI_SUM, PETSC_COMM_WORLD) != MPI_SUCCESS)
+      throw SolverError("PETSc: MPI_Scan of the row ranges failed");
+    row_begin_ = Index(end - local), row_end_ = Index(end);
+    std::vector<PetscInt> ci, cj;
+    position_.clear();
+    for (Index j = 0; j < n_; ++j)
+      for (Index k = A.outerIndexPtr()[j]; k < A.outerIndexPtr()[j + 1]; ++k) {
+        const Index i = A.innerIndexPtr()[k];
+        if (i < row_begin_ || i >= row_end_) continue;
+        ci.push_back(PetscInt(i)), cj.push_back(PetscInt(j)), position_.push_back(k);
+      }
+    values_.resize(position_.size());
+    ALEFSI_PETSC(MatCreate(PETSC_COMM_WORLD, &mat_));
+    ALEFSI_PETSC(MatSetSizes(mat_, local, local, global, global));
+    ALEFSI_PETSC(MatSetType(mat_, MATAIJ));
+    ALEFSI_PETSC(MatSetPreallocationCOO(mat_, PetscCount(ci.size()), ci.data(), cj.data()));
+    ALEFSI_PETSC(MatCreateVecs(mat_, &x_, &b_));
+    ALEFSI_PETSC(VecScatterCreateToAll(x_, &gather_, &x_all_));
+    ALEFSI_PETSC(KSPCreate(PETSC_COMM_WORLD, &ksp_));
+    if (!prefix_.empty()) ALEFSI_PETSC(KSPSetOptionsPrefix(ksp_, prefix_.c_str()));
+    first_ = true;
+  }
+
+  /// Copies A's values into the distributed matrix (A must have the analysed pattern; another
+  /// pattern is analysed first) and sets the KSP up: a numeric factorisation (MUMPS) or the
+  /// preconditioner's set-up (BoomerAMG), reusing the symbolic work of the same pattern.
+  void set_matrix(const SparseMatrix& A) {
+    if (!mat_ || A.rows() != n_ || A.nonZeros() != nnz_) analyze(A);
+    const Real* v = A.valuePtr();
+    for (std::size_t e = 0; e < position_.size(); ++e) values_[e] = PetscScalar(v[position_[e]]);
+    ALEFSI_PETSC(MatSetValuesCOO(mat_, values_.data(), INSERT_VALUES));
+    ALEFSI_PETSC(KSPSetOperators(ksp_, mat_, mat_));
+  }
+  void setup() { ALEFSI_PETSC(KSPSetUp(ksp_)); }
+
+  /// Solves with the KSP; `b` and the returned solution are whole (every rank's copy).
+  VecX solve(const VecX& b) {
+    ALEFSI_CHECK_ARG(b.size() == n_, "b", "has ", b.size(), " entries, the matrix ", n_, " rows");
+    PetscScalar* pb = nullptr;
+    ALEFSI_PETSC(VecGetArray(b_, &pb));
+    for (Index i = row_begin_; i < row_end_; ++i) pb[i - row_begin_] = b[i];
+    ALEFSI_PETSC(VecRestoreArray(b_, &pb));
+    ALEFSI_PETSC(KSPSolve(ksp_, b_, x_));
+    KSPConvergedReason reason;
+    ALEFSI_PETSC(KSPGetConvergedReason(ksp_, &reason));
+    PetscInt its = 0;
+    ALEFSI_PETSC(KSPGetIterationNumber(ksp_, &its));
+    iterations_ = int(its);
+    if (reason < 0) {
+      PetscReal rnorm = 0;
+      KSPGetResidualNorm(ksp_, &rnorm);
+      char res[32];
+      std::snprintf(res, sizeof res, "%.3e", double(rnorm / std::max<Real>(b.norm(), 1e-300)));
+      throw SolverError(std::string("PETSc KSP did not converge: ") + KSPConvergedReasons[reason] + " after " +
+                        std::to_string(its) + " iterations, relative residual " + res);
+    }
+    ALEFSI_PETSC(VecScatterBegin(gather_, x_, x_all_, INSERT_VALUES, SCATTER_FORWARD));
+    ALEFSI_PETSC(VecScatterEnd(gather_, x_, x_all_, INSERT_VALUES, SCATTER_FORWARD));
+    VecX x(n_);
+    const PetscScalar* px = nullptr;
+    ALEFSI_PETSC(VecGetArrayRead(x_all_, &px));
+    for (Index i = 0; i < n_; ++i) x[i] = Real(px[i]);
+    ALEFSI_PETSC(VecRestoreArrayRead(x_all_, &px));
+    return x;
+  }
+
+  KSP ksp() const { return ksp_; }
+  ::Mat matrix() const { return mat_; }
+  Index rows() const { return n_; }
+  Index row_begin() const { return row_begin_; }
+  Index row_end() const { return row_end_; }
+  int iterations() const { return iterations_; }
+  const std::string& prefix() const { return prefix_; }
+  /// True once after each analysis: the KSP's type and options are set then.
+  bool take_first() { return std::exchange(first_, false); }
+  /// Sets `-<prefix><name> value` in the options database unless the user gave that option
+  /// (an option a solver set before is a default, not the user's: it is set again).
+  void default_option(const char* name, const char* value) const {
+    static std::set<std::string> defaults;  // the options solvers set, not the user
+    const std::string key = "-" + prefix_ + name;
+    PetscBool given = PETSC_FALSE;
+    ALEFSI_PETSC(PetscOptionsHasName(nullptr, nullptr, key.c_str(), &given));
+    if (given && !defaults.count(key)) return;
+    ALEFSI_PETSC(PetscOptionsSetValue(nullptr, key.c_str(), value));
+    defaults.insert(key);
+  }
+
+ private:
+  void destroy_pattern() {
+    if (ksp_) KSPDestroy(&ksp_);
+    if (gather_) VecScatterDestroy(&gather_);
+    if (x_all_) VecDestroy(&x_all_);
+    if (x_) VecDestroy(&x_);
+    if (b_) VecDestroy(&b_);
+    if (mat_) MatDestroy(&mat_);
+  }
+
+  std::string prefix_;
+  KSP ksp_ = nullptr;
+  ::Mat mat_ = nullptr;
+  ::Vec x_ = nullptr, b_ = nullptr, x_all_ = nullptr;
+  VecScatter gather_ = nullptr;
+  Index n_ = 0, nnz_ = 0, row_begin_ = 0, row_end_ = 0;
+  std::vector<Index> position_;       // value-array positions of this rank's entries (COO order)
+  std::vector<PetscScalar> values_;  // their values, in COO order
+  int iterations_ = 0;
+  bool first_ = true;
+};
+
+}  // namespace detail
+
+/// MUMPS LU through PETSc (file comment). Options: `-pc_factor_mat_solver_type`, `-mat_mumps_*`.
+class PetscDirect {
+ public:
+  static constexpr const char* name = "PETSc LU (MUMPS)";
+  static constexpr bool direct = true;
+
+  explicit PetscDirect(std::string prefix = "") : sys_(std::move(prefix)) {}
+  void analyze(const SparseMatrix& A) { sys_.analyze(A); }
+  void factorize(const SparseMatrix& A) {
+    sys_.set_matrix(A);
+    if (sys_.take_first()) {
+      PC pc;
+      ALEFSI_PETSC(KSPSetType(sys_.ksp(), KSPPREONLY));
+      ALEFSI_PETSC(KSPGetPC(sys_.ksp(), &pc));
+      ALEFSI_PETSC(PCSetType(pc, PCLU));
+      ALEFSI_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+      ALEFSI_PETSC(KSPSetFromOptions(sys_.ksp()));
+    }
+    sys_.setup();
+  }
+  VecX solve(const VecX& b) { return sys_.solve(b); }
+  /// This rank's rows [row_begin, row_end).
+  Index row_begin() const { return sys_.row_begin(); }
+  Index row_end() const { return sys_.row_end(); }
+  KSP ksp() const { return sys_.ksp(); }
+
+ private:
+  detail::PetscSystem sys_;
+};
+
+/// Options of PetscKrylov that are not PETSc's own (those come from the options database).
+struct PetscKrylovOptions {
+  Real tolerance = 1e-8;  ///< on ||b - K x|| / ||b|| (-ksp_rtol overrides)
+  int max_iterations = 1000;
+  int restart = 60;
+  std::string prefix{};  ///< options prefix of this solver's KSP ("" : -ksp_type, ...)
+};
+
+/// GMRES with a fieldsplit-Schur preconditioner through PETSc (file comment). `D`: the
+/// dimension (the policy's type names it, as SaddlePointGmres<D>'s does; the splits do not
+/// depend on it).
+template <int D>
+class PetscKrylov {
+ public:
+  static constexpr const char* name = "PETSc GMRES+fieldsplit(Schur, BoomerAMG)";
+
+  explicit PetscKrylov(PetscKrylovOptions opt = {}) : opt_(std::move(opt)), sys_(opt_.prefix) {
+    ALEFSI_CHECK_ARG(opt_.tolerance > 0 && opt_.tolerance < 1, "tolerance", "must be in (0, 1), got ", opt_.tolerance);
+    ALEFSI_CHECK_ARG(opt_.max_iterations >= 1, "max_iterations", "must be positive");
+    ALEFSI_CHECK_ARG(opt_.restart >= 1, "restart", "must be positive");
+  }
+  ~PetscKrylov() { destroy_splits(); }
+  PetscKrylov(const PetscKrylov&) = delete;
+  PetscKrylov& operator=(const PetscKrylov&) = delete;
+
+  /// The space's blocks (la/saddle_point_blocks.hpp; optional): the split sizes, and the pressure
+  /// mass matrix for the Schur complement of steady Stokes. Takes effect at the next
+  /// `factorize`.
+  void set_blocks(SaddlePointBlocks blocks) {
+    blocks_ = std::move(blocks);
+    analyzed_ = false;
+  }
+
+  void analyze(const SparseMatrix& A) {
+    split_ = saddle_point_split(A, blocks_ ? &*blocks_ : nullptr, name);
+    sys_.analyze(A);
+    // this rank's rows of split 0 (velocities [0, nu) and bodies [nu + np, n)) and of split 1
+    const Index p0 = split_.n_velocity, e0 = p0 + split_.n_pressure;
+    std::vector<PetscInt> rows0, rows1;
+    for (Index i = sys_.row_begin(); i < sys_.row_end(); ++i) (i >= p0 && i < e0 ? rows1 : rows0).push_back(PetscInt(i));
+    destroy_splits();
+    ALEFSI_PETSC(ISCreateGeneral(PETSC_COMM_WORLD, PetscInt(rows0.size()), rows0.data(), PETSC_COPY_VALUES, &is0_));
+    ALEFSI_PETSC(ISCreateGeneral(PETSC_COMM_WORLD, PetscInt(rows1.size()), rows1.data(), PETSC_COPY_VALUES, &is1_));
+    analyzed_ = true;
+    configured_ = false;
+  }
+
+  void factorize(const SparseMatrix& A) {
+    if (!analyzed_ || A.rows() != sys_.rows()) analyze(A);
+    sys_.set_matrix(A);
+    if (sys_.take_first()) configured_ = false;
+    if (!configured_) configure(A);
+    sys_.setup();
+  }
+  VecX solve(const VecX& b) { return sys_.solve(b); }
+
+  int iterations() const { return sys_.iterations(); }
+  Index n_pressure() const { return split_.n_pressure; }
+  Index n_extra() const { return split_.n_extra; }
+  /// Whether the Schur complement is preconditioned by the pressure mass matrix (else selfp).
+  bool pressure_mass() const { return use_mass_; }
+  Index row_begin() const { return sys_.row_begin(); }
+  Index row_end() const { return sys_.row_end(); }
+  KSP ksp() const { return sys_.ksp(); }
+
+ private:
+  // The KSP's type, splits and defaults, then the options database.
+  void configure(const SparseMatrix& A) {
+    KSP ksp = sys_.ksp();
+    PC pc;
+    ALEFSI_PETSC(KSPSetType(ksp, KSPGMRES));
+    ALEFSI_PETSC(KSPGMRESSetRestart(ksp, PetscInt(opt_.restart)));
+    ALEFSI_PETSC(KSPSetPCSide(ksp, PC_RIGHT));
+    ALEFSI_PETSC(KSPSetTolerances(ksp, PetscReal(opt_.tolerance), 0.0, PETSC_DEFAULT, PetscInt(opt_.max_iterations)));
+    ALEFSI_PETSC(KSPGetPC(ksp, &pc));
+    ALEFSI_PETSC(PCSetType(pc, PCFIELDSPLIT));
+    ALEFSI_PETSC(PCFieldSplitSetIS(pc, "0", is0_));
+    ALEFSI_PETSC(PCFieldSplitSetIS(pc, "1", is1_));
+    ALEFSI_PETSC(PCFieldSplitSetType(pc, PC_COMPOSITE_SCHUR));
+    ALEFSI_PETSC(PCFieldSplitSetSchurFactType(pc, PC_FIELDSPLIT_SCHUR_FACT_UPPER));
+    use_mass_ = blocks_ && blocks_->pressure_mass.rows() == split_.n_pressure && blocks_->mass_coefficient == 0;
+    if (use_mass_) {
+      set_schur_matrix(A);
+      ALEFSI_PETSC(PCFieldSplitSetSchurPre(pc, PC_FIELDSPLIT_SCHUR_PRE_USER, schur_pre_));
+    } else {
+      ALEFSI_PETSC(PCFieldSplitSetSchurPre(pc, PC_FIELDSPLIT_SCHUR_PRE_SELFP, nullptr));
+    }
+    sys_.default_option("fieldsplit_0_ksp_type", "preonly");
+    sys_.default_option("fieldsplit_0_pc_type", "hypre");
+    sys_.default_option("fieldsplit_0_pc_hypre_type", "boomeramg");
+    if (use_mass_) {  // three Chebyshev–Jacobi steps on the pressure mass (as SaddlePointGmres)
+      sys_.default_option("fieldsplit_1_ksp_type", "chebyshev");
+      sys_.default_option("fieldsplit_1_ksp_max_it", "3");
+      sys_.default_option("fieldsplit_1_ksp_norm_type", "none");
+      sys_.default_option("fieldsplit_1_pc_type", "jacobi");
+    } else {
+      sys_.default_option("fieldsplit_1_ksp_type", "preonly");
+      sys_.default_option("fieldsplit_1_pc_type", "hypre");
+    }
+    ALEFSI_PETSC(KSPSetFromOptions(ksp));
+    configured_ = true;
+  }
+  // S~ = -C - M_p / mu (PETSc's Schur complement is A_pp - B A^-1 B^T, negative: A_pp = -C),
+  // this rank's pressure rows, in the numbering of split 1 (PETSc numbers a split's unknowns in
+  // rank order: this rank's pressures are contiguous there).
+  void set_schur_matrix(const SparseMatrix& A) {
+    const SparseMatrix& Mp = blocks_->pressure_mass;
+    const Index p0 = split_.n_velocity, np = split_.n_pressure;
+    const Index lo = std::clamp(sys_.row_begin() - p0, Index(0), np), hi = std::clamp(sys_.row_end() - p0, Index(0), np);
+    std::vector<PetscInt> ci, cj;
+    std::vector<PetscScalar> v;
+    auto add = [&](Index i, Index j, Real value) {
+      if (i >= lo && i < hi) ci.push_back(PetscInt(i)), cj.push_back(PetscInt(j)), v.push_back(PetscScalar(value));
+    };
+    for (Index j = 0; j < np; ++j) {
+      for (SparseMatrix::InnerIterator it(Mp, j); it; ++it) add(it.row(), j, -it.value() / blocks_->mu);
+      for (SparseMatrix::InnerIterator it(A, p0 + j); it; ++it)  // COO sums repeated entries
+        if (it.row() >= p0 && it.row() < p0 + np) add(it.row() - p0, j, it.value());
+    }
+    if (schur_pre_) MatDestroy(&schur_pre_);
+    ALEFSI_PETSC(MatCreate(PETSC_COMM_WORLD, &schur_pre_));
+    ALEFSI_PETSC(MatSetSizes(schur_pre_, PetscInt(hi - lo), PetscInt(hi - lo), PetscInt(np), PetscInt(np)));
+    ALEFSI_PETSC(MatSetType(schur_pre_, MATAIJ));
+    ALEFSI_PETSC(MatSetPreallocationCOO(schur_pre_, PetscCount(ci.size()), ci.data(), cj.data()));
+    ALEFSI_PETSC(MatSetValuesCOO(schur_pre_, v.data(), INSERT_VALUES));
+  }
+  void destroy_splits() {
+    PetscBool down = PETSC_FALSE;
+    PetscFinalized(&down);
+    if (down) return;
+    if (is0_) ISDestroy(&is0_);
+    if (is1_) ISDestroy(&is1_);
+    if (schur_pre_) MatDestroy(&schur_pre_);
+  }
+
+  PetscKrylovOptions opt_;
+  detail::PetscSystem sys_;
+  std::optional<SaddlePointBlocks> blocks_;
+  SaddlePointSplit split_;
+  IS is0_ = nullptr, is1_ = nullptr;
+  ::Mat schur_pre_ = nullptr;
+  bool analyzed_ = false, configured_ = false, use_mass_ = false;
+};
+
+static_assert(LinearSolver<PetscDirect> && DirectSolver<PetscDirect>, "PetscDirect must model DirectSolver");
+static_assert(LinearSolver<PetscKrylov<3>>, "PetscKrylov must model LinearSolver");
+
+}  // namespace alefsi

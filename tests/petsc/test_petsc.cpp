@@ -1,0 +1,199 @@
+// The PETSc solver policies (la/petsc.hpp), on one rank and under `mpirun -n 2`: each rank
+// solves the distributed system and compares the gathered answer with the serial solve that it
+// computes itself (every rank holds the whole matrix), so the several-rank answer is checked
+// against the one-rank answer to the solver tolerance. Built only when PETSc is found.
+//
+//   build/release/tests/alefsi_test_petsc                       one rank
+//   mpirun -n 2 build/release/tests/alefsi_test_petsc           two ranks
+//   ... -- -ksp_monitor                                         PETSc options after "--"
+// PETSc's C types Vec and Mat live in the global namespace: with `using namespace alefsi`,
+// alefsi's Vec<D> and Mat<D> are spelled out.
+#define CATCH_CONFIG_RUNNER
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <iostream>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "../support/stokes_systems.hpp"
+#include "alefsi/fem/norms.hpp"
+#include "alefsi/la/petsc.hpp"
+#include "alefsi/la/solvers.hpp"
+#include "alefsi/mesh/io/gmsh.hpp"
+#include "alefsi/physics/stokes.hpp"
+#include "alefsi/sim/ale_flow.hpp"
+
+using namespace alefsi;
+using alefsi::testing::cavity3d;
+using std::numbers::pi;
+
+namespace {
+
+Real relative_residual(const SparseMatrix& A, const VecX& x, const VecX& b) { return (A * x - b).norm() / b.norm(); }
+
+VecX serial_solve(const SparseMatrix& A, const VecX& b) {
+  SparseLu<> lu;
+  lu.analyze(A);
+  lu.factorize(A);
+  return lu.solve(b);
+}
+
+// Every row is owned by exactly one rank, in rank order.
+template <class S>
+void check_ownership(const S& s, Index n) {
+  long long mine = s.row_end() - s.row_begin(), total = 0;
+  MPI_Allreduce(&mine, &total, 1, MPI_LONG_LONG, MPI_SUM, PETSC_COMM_WORLD);
+  CHECK(total == n);
+  if (PetscSession::rank() == PetscSession::size() - 1) CHECK(s.row_end() == n);
+  if (PetscSession::rank() == 0) CHECK(s.row_begin() == 0);
+}
+
+// 3D manufactured solution (as tests/physics/test_stokes.cpp): u = (s c c, c s c, -2 c c s),
+// p = c c c, mu = 0.7.
+constexpr Real mu = 0.7;
+alefsi::Vec<3> exact_u(const alefsi::Vec<3>& x) {
+  const Real s0 = std::sin(pi * x[0]), c0 = std::cos(pi * x[0]), s1 = std::sin(pi * x[1]), c1 = std::cos(pi * x[1]),
+             s2 = std::sin(pi * x[2]), c2 = std::cos(pi * x[2]);
+  return {s0 * c1 * c2, c0 * s1 * c2, -2 * c0 * c1 * s2};
+}
+alefsi::Mat<3> exact_grad(const alefsi::Vec<3>& x) {
+  const Real s0 = std::sin(pi * x[0]), c0 = std::cos(pi * x[0]), s1 = std::sin(pi * x[1]), c1 = std::cos(pi * x[1]),
+             s2 = std::sin(pi * x[2]), c2 = std::cos(pi * x[2]);
+  alefsi::Mat<3> g;
+  g << c0 * c1 * c2, -s0 * s1 * c2, -s0 * c1 * s2,  //
+      -s0 * s1 * c2, c0 * c1 * c2, -c0 * s1 * s2,   //
+      2 * s0 * c1 * s2, 2 * c0 * s1 * s2, -2 * c0 * c1 * c2;
+  return pi * g;
+}
+Real exact_p(const alefsi::Vec<3>& x) { return std::cos(pi * x[0]) * std::cos(pi * x[1]) * std::cos(pi * x[2]); }
+alefsi::Vec<3> exact_f(const alefsi::Vec<3>& x) {
+  const Real s0 = std::sin(pi * x[0]), c0 = std::cos(pi * x[0]), s1 = std::sin(pi * x[1]), c1 = std::cos(pi * x[1]),
+             s2 = std::sin(pi * x[2]), c2 = std::cos(pi * x[2]);
+  return 3 * pi * pi * mu * exact_u(x) - pi * alefsi::Vec<3>(s0 * c1 * c2, c0 * s1 * c2, c0 * c1 * s2);
+}
+
+}  // namespace
+
+TEST_CASE("PetscDirect (MUMPS) and PetscKrylov solve 3D Stokes (P2/P1, P1/P1-GLS) as the serial SparseLU does",
+          "[petsc][quick]") {
+  for (int pair = 0; pair < 2; ++pair) {
+    const auto s = pair == 0 ? cavity3d<TaylorHood>(6) : cavity3d<P1P1Gls>(8);
+    const VecX reference = serial_solve(s.A, s.b);
+    {
+      PetscDirect lu;
+      lu.analyze(s.A);
+      for (int rep = 0; rep < 2; ++rep) {  // a second factorisation of the same pattern
+        lu.factorize(s.A);
+        const VecX x = lu.solve(s.b);
+        CHECK(relative_residual(s.A, x, s.b) <= 1e-12);
+        CHECK((x - reference).norm() <= 1e-10 * reference.norm());
+      }
+      check_ownership(lu, s.A.rows());
+    }
+    for (bool blocks : {false, true}) {
+      CAPTURE(pair, blocks);
+      PetscKrylov<3> k({.tolerance = 1e-11});
+      if (blocks) k.set_blocks(s.blocks);
+      k.analyze(s.A);
+      k.factorize(s.A);
+      CHECK(k.n_pressure() == s.blocks.n_pressure);  // without blocks: from the diagonal's sign
+      CHECK(k.n_extra() == 0);
+      CHECK(k.pressure_mass() == blocks);
+      const VecX x = k.solve(s.b);
+      std::cout << "PETSc GMRES+fieldsplit, " << (pair == 0 ? "P2/P1" : "P1/P1-GLS") << ", "
+                << (blocks ? "Schur ~ M_p/mu" : "Schur ~ selfp") << ": " << k.iterations() << " iterations, "
+                << s.A.rows() << " unknowns, " << PetscSession::size() << " rank(s)\n";
+      CHECK(relative_residual(s.A, x, s.b) <= 1e-11);
+      // ||x - x*|| <= ||K^-1|| ||r||: the pinned-pressure system has ||K^-1|| ||K|| ~ 1e4 here
+      CHECK((x - reference).norm() <= 1e-6 * reference.norm());
+      check_ownership(k, s.A.rows());
+    }
+  }
+}
+
+TEST_CASE("PetscKrylov: bad input and a solve that cannot converge are typed errors", "[petsc][quick]") {
+  CHECK_THROWS_AS(PetscKrylov<3>({.tolerance = 0}), InvalidArgument);
+  CHECK_THROWS_AS(PetscKrylov<3>({.restart = 0}), InvalidArgument);
+  PetscKrylov<3> k;
+  SparseMatrix spd(2, 2);
+  spd.insert(0, 0) = 1, spd.insert(1, 1) = 2;
+  spd.makeCompressed();
+  CHECK_THROWS_AS(k.analyze(spd), SolverError);  // no saddle point: nothing to call pressure
+  // two iterations cannot reach 1e-12: the error names the reason and the residual
+  const auto s = cavity3d<TaylorHood>(4);
+  PetscKrylov<3> few({.tolerance = 1e-12, .max_iterations = 2});
+  few.analyze(s.A);
+  few.factorize(s.A);
+  CHECK_THROWS_WITH(few.solve(s.b), Catch::Contains("DIVERGED_ITS") && Catch::Contains("relative residual") &&
+                                        Catch::Contains("e-"));
+  VecX wrong = VecX::Ones(3);
+  CHECK_THROWS_AS(few.solve(wrong), InvalidArgument);
+}
+
+TEST_CASE("3D Taylor–Hood solved through PetscKrylov converges at rates 3 / 2 with the serial errors",
+          "[petsc][convergence]") {
+  // the errors of the PETSc solves equal the SparseLU solves' to 1e-7 (the solver tolerance,
+  // 1e-10, times the system's conditioning), so the rates are those of
+  // tests/physics/test_stokes.cpp: asserted over n = 8 -> 12 with the same bands
+  std::vector<Real> N, eu, eh;
+  for (int n : {4, 8, 12}) {
+    const Mesh<3> mesh = box_mesh(n, n, n);
+    Stokes<3, TaylorHood> stokes(mesh, mu, exact_f);
+    for (Index f : mesh.boundary_facets()) stokes.set_velocity(mesh.facet_tag(f), exact_u);
+    const VecX field = stokes.solve(PetscKrylov<3>({.tolerance = 1e-10}));
+    const VecX serial = stokes.solve();
+    const auto e = flow_errors<3, TaylorHood>(stokes.space(), field, exact_u, exact_grad, exact_p);
+    const auto e0 = flow_errors<3, TaylorHood>(stokes.space(), serial, exact_u, exact_grad, exact_p);
+    CHECK(e.u_l2 == Approx(e0.u_l2).epsilon(1e-7));
+    CHECK(e.u_h1 == Approx(e0.u_h1).epsilon(1e-7));
+    CHECK(e.p_l2 == Approx(e0.p_l2).epsilon(1e-6));
+    N.push_back(Real(field.size())), eu.push_back(e.u_l2), eh.push_back(e.u_h1);
+    std::cout << "3D Taylor-Hood via PETSc, n = " << n << ": |u-uh|_L2 " << e.u_l2 << ", |u-uh|_H1 " << e.u_h1
+              << ", |p-ph|_L2 " << e.p_l2 << "\n";
+  }
+  CHECK(observed_rate(N[1], eu[1], N[2], eu[2], 3) == Approx(3.0).margin(0.2));
+  CHECK(observed_rate(N[1], eh[1], N[2], eh[2], 3) == Approx(2.0).margin(0.15));
+}
+
+TEST_CASE("AleFlow with PetscKrylov<3> or PetscDirect: 3D Navier–Stokes steps with a free sphere match the serial "
+          "direct solve",
+          "[petsc][bodies3d][quick]") {
+  // a free, neutrally buoyant sphere in simple shear (as tests/fem/test_solvers.cpp with
+  // SaddlePointGmres): the 6 body unknowns join split 0, beside the velocities
+  const Real a = 0.2, gamma = 1.0;
+  auto run = [&](auto& flow) {
+    flow.set_velocity(1, [&](const alefsi::Vec<3>& x, Real) { return alefsi::Vec<3>(gamma * x[1], 0.0, 0.0); });
+    flow.add_body(sphere_body(5, alefsi::Vec<3>::Zero(), a, 1.0));
+    flow.set_initial_velocity([&](const alefsi::Vec<3>& x) { return alefsi::Vec<3>(gamma * x[1], 0.0, 0.0); });
+    StepReport rep;
+    for (int n = 0; n < 2; ++n) rep = flow.step(0.05);
+    return rep;
+  };
+  const Mesh<3> mesh = read_gmsh<3>(std::string(ALEFSI_TEST_DATA_DIR) + "/gmsh/sphere_in_box3d.msh").mesh;
+  AleFlow<FlowConfig<3, TaylorHood, BDF2_BDF2E>> serial(mesh, FlowOptions{1.0, 1.0});
+  AleFlow<FlowConfig<3, TaylorHood, BDF2_BDF2E>::with_solver<PetscKrylov<3>>> krylov(mesh, FlowOptions{1.0, 1.0});
+  AleFlow<FlowConfig<3, TaylorHood, BDF2_BDF2E>::with_solver<PetscDirect>> direct(mesh, FlowOptions{1.0, 1.0});
+  run(serial);
+  const StepReport rk = run(krylov);
+  run(direct);
+  CHECK(rk.newton_iterations <= 4);  // GMRES to 1e-8 per Newton update, Newton to 1e-10
+  const VecX& u0 = serial.field();
+  CHECK((krylov.field() - u0).norm() <= 1e-7 * u0.norm());
+  CHECK((krylov.body_velocity(0) - serial.body_velocity(0)).norm() <= 1e-7 * serial.body_velocity(0).norm());
+  CHECK((direct.field() - u0).norm() <= 1e-10 * u0.norm());
+  CHECK((direct.body_velocity(0) - serial.body_velocity(0)).norm() <= 1e-10 * serial.body_velocity(0).norm());
+}
+
+// Catch2 reads the arguments before "--"; PETSc reads them all (its options go after "--").
+int main(int argc, char** argv) {
+  PetscSession petsc(argc, argv);
+  int catch_argc = argc;
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--") {
+      catch_argc = i;
+      break;
+    }
+  return Catch::Session().run(catch_argc, argv);
+}

@@ -13,7 +13,11 @@
 //          --solvers a,b,..  (default krylov,krylov-mass,umfpack): krylov (SaddlePointGmres<3>,
 //                   algebraic Schur), krylov-mass (with saddle_point_blocks: pressure mass,
 //                   Cahouet–Chabard when --mass > 0), umfpack (UmfPackLu symmetric), sparselu
-//                   (SparseLu<>), bicgstab (BiCgStabIlut, tolerance --tol, 2000 iterations)
+//                   (SparseLu<>), bicgstab (BiCgStabIlut, tolerance --tol, 2000 iterations);
+//                   with PETSc (built against alefsi::petsc): petsc (PetscKrylov<3>: GMRES +
+//                   fieldsplit Schur, BoomerAMG, selfp), petsc-mass (with the blocks: the
+//                   pressure mass), mumps (PetscDirect). Under `mpirun -n P` pass only these:
+//                   every rank runs the others too. PETSc options after "--".
 //          --direct-max N   (default 16) largest N for the direct solvers
 //          --tol T   (default 1e-8) GMRES relative tolerance; --restart M (default 60)
 //          --strength THETA, --sweeps S   AMG strength threshold (0.08) and Gauss–Seidel sweeps (1)
@@ -46,6 +50,9 @@
 #include "alefsi/la/suitesparse.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
 #include "alefsi/physics/stokes.hpp"
+#ifdef ALEFSI_HAVE_PETSC
+#include "alefsi/la/petsc.hpp"
+#endif
 
 namespace {
 
@@ -169,7 +176,7 @@ struct Row {
 };
 
 template <class Solver>
-Row run(const System& s, Solver solver, VecX& x) {
+Row run(const System& s, Solver&& solver, VecX& x) {
   Row row;
   reset_peak_rss();
   const double c0 = cpu_seconds(), w0 = wall_seconds();
@@ -187,6 +194,8 @@ Row run(const System& s, Solver solver, VecX& x) {
     row.iterations = solver.iterations();
     row.levels = solver.velocity_amg().n_levels();
     row.complexity = solver.velocity_amg().operator_complexity();
+  } else if constexpr (requires { solver.iterations(); }) {
+    row.iterations = solver.iterations();
   }
   return row;
 }
@@ -264,15 +273,40 @@ void bench(const Options& o, const char* pair) {
     if (has(o.solvers, "krylov-mass")) {
       SaddlePointGmres<3> k(o.krylov);
       k.set_blocks(s.blocks);
-      const Row r = run(s, std::move(k), x);
+      const Row r = run(s, k, x);
       print(o.mass > 0 ? "GMRES + AMG, mass + Cahouet–Chabard" : "GMRES + AMG, pressure mass", r, x);
     }
+#ifdef ALEFSI_HAVE_PETSC
+    const std::string ranks = " (" + std::to_string(PetscSession::size()) + " rank" + (PetscSession::size() > 1 ? "s)" : ")");
+    const PetscKrylovOptions popt{.tolerance = o.krylov.tolerance, .restart = o.krylov.restart};
+    if (has(o.solvers, "mumps") && n <= o.direct_max) {
+      const Row r = run(s, PetscDirect{}, x);
+      if (!direct) direct = x;
+      print(("PETSc MUMPS LU" + ranks).c_str(), r, x);
+    }
+    if (has(o.solvers, "petsc")) {
+      const Row r = run(s, PetscKrylov<3>(popt), x);
+      print(("PETSc GMRES + fieldsplit (BoomerAMG, selfp)" + ranks).c_str(), r, x);
+    }
+    if (has(o.solvers, "petsc-mass")) {
+      PetscKrylov<3> k(popt);
+      k.set_blocks(s.blocks);
+      const Row r = run(s, k, x);
+      print(("PETSc GMRES + fieldsplit (BoomerAMG, pressure mass)" + ranks).c_str(), r, x);
+    }
+#endif
   }
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+#ifdef ALEFSI_HAVE_PETSC
+  PetscSession petsc(argc, argv);
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--") argc = i;  // PETSc's options follow
+  if (PetscSession::rank() > 0 && !std::freopen("/dev/null", "w", stdout)) return 1;  // rank 0 prints the table
+#endif
   Options o;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];

@@ -37,8 +37,19 @@
 // Expected: |V_x - 1/3| / (1/3) under 1 % from h0 = R / 3 on (0.03 % at the default R / 6),
 // spurious V_y, V_z, w at round-off level on the symmetric mesh (docs/results.md has the
 // measured table and the resolution and box-size study).
+//
+// Under MPI (target sphere_squirmer_mpi, built when alefsi::petsc is found): the same program
+// with one type changed, the solver, to alefsi::PetscDirect (MUMPS through PETSc):
+//   mpirun -n 2 ./sphere_squirmer_mpi [options as above] [-- PETSc options, e.g. -ksp_view]
+// Every rank holds the mesh and assembles; the solve is distributed; rank 0 runs gmsh, prints
+// and writes the files. The answer is the serial one to the direct solver's round-off.
+// (PETSc's C types Vec and Mat are global: next to `using namespace alefsi` this file spells
+// alefsi::Vec and alefsi::Mat out, in both builds.)
 #include <alefsi/alefsi.hpp>
 #include <alefsi/app.hpp>
+#ifdef ALEFSI_SQUIRMER_PETSC
+#include <alefsi/la/petsc.hpp>
+#endif
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -66,7 +77,12 @@ using std::numbers::pi;
 // SparseLu<> on the 40k-unknown mesh (10 / 10 / 20 / 27 s CPU), SparseLu the leanest (0.9 GB
 // against 1.5 GB); UMFPACK's 32-bit version (Eigen's wrapper) stops with "out of memory" near
 // 9e4 unknowns (docs/results.md).
-using Flow = AleFlow<FlowConfig<3, TaylorHood, BSS, UnsteadyStokes, DefaultDirectSolver>>;
+#ifdef ALEFSI_SQUIRMER_PETSC
+using Solver = PetscDirect;
+#else
+using Solver = DefaultDirectSolver;
+#endif
+using Flow = AleFlow<FlowConfig<3, TaylorHood, BSS, UnsteadyStokes, Solver>>;
 
 namespace {
 constexpr Real R = 0.25;
@@ -160,21 +176,21 @@ std::filesystem::path run_gmsh(const Settings& o) {
 // reoriented; the symmetry-plane facets become interior and are dropped.
 Mesh<3> mirror_octant(const Mesh<3>& m, Real H) {
   const Index n = m.n_nodes();
-  std::vector<Vec<3>> x(m.coordinates());
+  std::vector<alefsi::Vec<3>> x(m.coordinates());
   for (auto& p : x)
     for (int c = 0; c < 3; ++c) {
       ALEFSI_CHECK_ARG(p[c] >= -1e-12 * H, "mesh", "not an octant mesh: a node has coordinate ", p[c]);
       if (std::abs(p[c]) <= 1e-12 * H) p[c] = 0;
     }
   std::vector<Index> id(8 * std::size_t(n), -1);
-  std::vector<Vec<3>> nodes;
+  std::vector<alefsi::Vec<3>> nodes;
   auto image = [&](Index v, int s) {  // s: bit c set = mirror coordinate c
     int eff = 0;
     for (int c = 0; c < 3; ++c)
       if ((s >> c & 1) && x[v][c] != 0) eff |= 1 << c;
     Index& k = id[8 * std::size_t(v) + eff];
     if (k < 0) {
-      Vec<3> p = x[v];
+      alefsi::Vec<3> p = x[v];
       for (int c = 0; c < 3; ++c)
         if (eff >> c & 1) p[c] = -p[c];
       k = Index(nodes.size());
@@ -209,7 +225,7 @@ Mesh<3> mirror_octant(const Mesh<3>& m, Real H) {
 // For each point, the first cell containing it (barycentric coordinates >= -1e-10); points in
 // no cell (inside the sphere, outside the box) get NaN. Candidates by the cells' bounding boxes
 // against the points sorted by x.
-std::vector<Vec<3>> sample_velocity(const Flow& flow, const std::vector<Vec<3>>& pts) {
+std::vector<alefsi::Vec<3>> sample_velocity(const Flow& flow, const std::vector<alefsi::Vec<3>>& pts) {
   const auto& m = flow.mesh();
   const auto& V = flow.space().velocity();
   using P2 = Lagrange<3, 2>;
@@ -219,24 +235,24 @@ std::vector<Vec<3>> sample_velocity(const Flow& flow, const std::vector<Vec<3>>&
   std::vector<Real> xs(pts.size());
   for (std::size_t i = 0; i < pts.size(); ++i) xs[i] = pts[order[i]][0];
   const Real nan = std::numeric_limits<Real>::quiet_NaN();
-  std::vector<Vec<3>> u(pts.size(), Vec<3>(nan, nan, nan));
+  std::vector<alefsi::Vec<3>> u(pts.size(), alefsi::Vec<3>(nan, nan, nan));
   std::vector<char> found(pts.size(), 0);
   for (Index c = 0; c < m.n_cells(); ++c) {
-    Vec<3> lo = m.node(m.cell(c)[0]), hi = lo;
+    alefsi::Vec<3> lo = m.node(m.cell(c)[0]), hi = lo;
     for (Index v : m.cell(c)) lo = lo.cwiseMin(m.node(v)), hi = hi.cwiseMax(m.node(v));
     const Real eps = 1e-10 * (hi - lo).norm();
     auto it = std::lower_bound(xs.begin(), xs.end(), lo[0] - eps);
     bool have_inverse = false;
-    Mat<3> Jinv = Mat<3>::Zero();
+    alefsi::Mat<3> Jinv = alefsi::Mat<3>::Zero();
     for (; it != xs.end() && *it <= hi[0] + eps; ++it) {
       const Index p = order[std::size_t(it - xs.begin())];
-      const Vec<3>& y = pts[p];
+      const alefsi::Vec<3>& y = pts[p];
       if (found[p] || y[1] < lo[1] - eps || y[1] > hi[1] + eps || y[2] < lo[2] - eps || y[2] > hi[2] + eps) continue;
       if (!have_inverse) Jinv = m.jacobian(c).inverse(), have_inverse = true;
-      const Vec<3> xi = Jinv * (y - m.node(m.cell(c)[0]));
+      const alefsi::Vec<3> xi = Jinv * (y - m.node(m.cell(c)[0]));
       if (xi.minCoeff() < -1e-10 || xi.sum() > 1 + 1e-10) continue;
       const auto phi = P2::values(xi);
-      Vec<3> val = Vec<3>::Zero();
+      alefsi::Vec<3> val = alefsi::Vec<3>::Zero();
       const auto& dofs = V.cell_dofs(c);
       for (int a = 0; a < P2::n_dofs; ++a)
         for (int k = 0; k < 3; ++k) val[k] += phi[a] * flow.field()[flow.space().velocity_field(dofs[a], k)];
@@ -255,34 +271,34 @@ std::vector<Vec<3>> sample_velocity(const Flow& flow, const std::vector<Vec<3>>&
 // On the walls it measures the momentum balance of the fluid: the squirmer is force- and
 // torque-free, so the walls feel no net force either (the sphere's own stress integral is a poor
 // measure here: the slip's jump at the equator makes its shear stress singular).
-Vec<6> surface_load(const Flow& flow, int tag, Real mu) {
+alefsi::Vec<6> surface_load(const Flow& flow, int tag, Real mu) {
   const auto& m = flow.mesh();
   using P2 = Lagrange<3, 2>;
   using P1 = Lagrange<3, 1>;
-  Vec<6> load = Vec<6>::Zero();
+  alefsi::Vec<6> load = alefsi::Vec<6>::Zero();
   for (Index f : m.boundary_facets()) {
     if (m.facet_tag(f) != tag) continue;
     const Index c = m.facet_cells(f)[0];
     const auto& fv = m.facet(f);
-    const Vec<3> a = m.node(fv[0]), b = m.node(fv[1]), d = m.node(fv[2]);
-    Vec<3> n = (b - a).cross(d - a);
+    const alefsi::Vec<3> a = m.node(fv[0]), b = m.node(fv[1]), d = m.node(fv[2]);
+    alefsi::Vec<3> n = (b - a).cross(d - a);
     const Real area = 0.5 * n.norm();
     n.normalize();
     if (n.dot(m.centroid(c) - (a + b + d) / 3) < 0) n = -n;  // out of the body = into the fluid cell
-    const Mat<3> Jinv = m.jacobian(c).inverse();
+    const alefsi::Mat<3> Jinv = m.jacobian(c).inverse();
     const auto& vd = flow.space().velocity().cell_dofs(c);
     const auto& pd = flow.space().pressure().cell_dofs(c);
-    for (const Vec<3>& y : {Vec<3>(0.5 * (a + b)), Vec<3>(0.5 * (b + d)), Vec<3>(0.5 * (d + a))}) {
-      const Vec<3> xi = Jinv * (y - m.node(m.cell(c)[0]));
+    for (const alefsi::Vec<3>& y : {alefsi::Vec<3>(0.5 * (a + b)), alefsi::Vec<3>(0.5 * (b + d)), alefsi::Vec<3>(0.5 * (d + a))}) {
+      const alefsi::Vec<3> xi = Jinv * (y - m.node(m.cell(c)[0]));
       const Eigen::Matrix<Real, P2::n_dofs, 3> G = P2::gradients(xi) * Jinv;
       const auto psi = P1::values(xi);
-      Mat<3> grad = Mat<3>::Zero();  // grad(k, j) = d u_k / d x_j
+      alefsi::Mat<3> grad = alefsi::Mat<3>::Zero();  // grad(k, j) = d u_k / d x_j
       for (int i = 0; i < P2::n_dofs; ++i)
         for (int k = 0; k < 3; ++k) grad.row(k) += flow.field()[flow.space().velocity_field(vd[i], k)] * G.row(i);
       Real p = 0;
       for (int i = 0; i < P1::n_dofs; ++i) p += psi[i] * flow.field()[flow.space().pressure_field(pd[i])];
-      const Mat<3> sigma = -p * Mat<3>::Identity() + mu * (grad + grad.transpose());
-      const Vec<3> t = sigma * n * (area / 3);
+      const alefsi::Mat<3> sigma = -p * alefsi::Mat<3>::Identity() + mu * (grad + grad.transpose());
+      const alefsi::Vec<3> t = sigma * n * (area / 3);
       load.head<3>() += t;
       load.tail<3>() += y.cross(t);
     }
@@ -303,7 +319,7 @@ void write_flow_vtu(const Flow& flow, const std::filesystem::path& file) {
 
 // The z = 0 plane, [-a, a]^2 on an n x n grid.
 void write_plane(const Flow& flow, Real a, int n, const std::filesystem::path& file) {
-  std::vector<Vec<3>> pts;
+  std::vector<alefsi::Vec<3>> pts;
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) pts.emplace_back(-a + 2 * a * i / (n - 1), -a + 2 * a * j / (n - 1), 0.0);
   const auto u = sample_velocity(flow, pts);
@@ -322,13 +338,13 @@ struct Decay {
 Decay decay_profile(const Flow& flow, Real H) {
   const int nr = 60, nd = 200;
   Decay d;
-  std::vector<Vec<3>> dirs = {Vec<3>(1, 0, 0), Vec<3>(-1, 0, 0), Vec<3>(0, 1, 0), Vec<3>(1, 1, 1).normalized()};
+  std::vector<alefsi::Vec<3>> dirs = {alefsi::Vec<3>(1, 0, 0), alefsi::Vec<3>(-1, 0, 0), alefsi::Vec<3>(0, 1, 0), alefsi::Vec<3>(1, 1, 1).normalized()};
   const Real golden = pi * (3 - std::sqrt(5.0));
   for (int k = 0; k < nd; ++k) {
     const Real z = 1 - (2 * k + 1.0) / nd, s = std::sqrt(1 - z * z);
     dirs.emplace_back(s * std::cos(golden * k), s * std::sin(golden * k), z);
   }
-  std::vector<Vec<3>> pts;
+  std::vector<alefsi::Vec<3>> pts;
   for (int i = 0; i < nr; ++i) {
     const Real r = 1.02 * R * std::pow(0.95 * H / (1.02 * R), Real(i) / (nr - 1));
     d.r.push_back(r);
@@ -353,8 +369,8 @@ Decay decay_profile(const Flow& flow, Real H) {
 // even for L the whole box (200 cm): the Stokes limit to that accuracy.
 constexpr FlowOptions stokes{.rho = 1e-12, .mu = 1, .linearisation = Linearisation::semi_implicit};
 void configure(Flow& flow) {
-  flow.set_velocity(tag_walls, [](const Vec<3>&, Real) { return Vec<3>(0, 0, 0); });
-  flow.set_prescribed_mesh_velocity([](const Vec<3>&, Real) { return Vec<3>(0, 0, 0); });
+  flow.set_velocity(tag_walls, [](const alefsi::Vec<3>&, Real) { return alefsi::Vec<3>(0, 0, 0); });
+  flow.set_prescribed_mesh_velocity([](const alefsi::Vec<3>&, Real) { return alefsi::Vec<3>(0, 0, 0); });
 }
 
 void print_report(const StepReport& rep) {
@@ -363,16 +379,31 @@ void print_report(const StepReport& rep) {
 }
 }  // namespace
 
-int main(int argc, char** argv) try {
+int squirmer_main(int argc, char** argv) try {
+#ifdef ALEFSI_SQUIRMER_PETSC
+  for (int i = 1; i < argc; ++i)  // PETSc's options: after "--"
+    if (std::string(argv[i]) == "--") argc = i;
+  const bool root = PetscSession::rank() == 0;
+  if (!root) std::cout.rdbuf(nullptr);  // rank 0 prints
+#else
+  const bool root = true;
+#endif
   Settings o;
   if (!parse(argc, argv, o)) return 0;
-  std::filesystem::create_directories(o.output);
+  if (root) std::filesystem::create_directories(o.output);
   const Real H = o.half_side, mu = 1;
-  const Vec<3> Q(-1, 0, 0), east(1, 0, 0), V_exact(1.0 / 3, 0, 0);
+  const alefsi::Vec<3> Q(-1, 0, 0), east(1, 0, 0), V_exact(1.0 / 3, 0, 0);
   Stopwatch total, sw;
 
   // --- mesh
-  const std::string msh = o.msh.empty() ? run_gmsh(o).string() : o.msh;
+  std::string msh = o.msh;
+  if (msh.empty()) {  // rank 0 meshes, the others read its file
+    if (root) run_gmsh(o);
+    msh = (o.output / "mesh.msh").string();
+  }
+#ifdef ALEFSI_SQUIRMER_PETSC
+  MPI_Barrier(PETSC_COMM_WORLD);
+#endif
   const Mesh<3> read = read_gmsh<3>(msh).mesh;
   const bool octant = !read.boundary_nodes(2).empty();  // symmetry planes tagged 2, 3, 4
   const Mesh<3> mesh = octant ? mirror_octant(read, H) : read;
@@ -390,7 +421,7 @@ int main(int argc, char** argv) try {
   {
     Flow flow(mesh, stokes);
     configure(flow);
-    RigidBody3D body = massless_sphere(tag_sphere, Vec<3>::Zero(), R);
+    RigidBody3D body = massless_sphere(tag_sphere, alefsi::Vec<3>::Zero(), R);
     body.slip = tangential_slip(Q, east);
     // the slip minus the O(h^2) normal velocity its interpolant leaks through the polygonal
     // sphere (physics/rigid_body.hpp: else the pinned pressure DOF takes it up as a point source)
@@ -408,9 +439,9 @@ int main(int argc, char** argv) try {
     std::cout << "    solved: " << sw.lap() << "; memory now " << std::fixed << std::setprecision(0) << current_mb()
               << " MB (the matrix and the LU factors the flow keeps), peak " << peak_mb() << " MB\n";
     print_report(rep);
-    const Vec<6> Z = flow.body_velocity(0);
-    const Vec<3> V = Z.head<3>(), w = Z.tail<3>();
-    const Vec<6> walls = surface_load(flow, tag_walls, mu);
+    const alefsi::Vec<6> Z = flow.body_velocity(0);
+    const alefsi::Vec<3> V = Z.head<3>(), w = Z.tail<3>();
+    const alefsi::Vec<6> walls = surface_load(flow, tag_walls, mu);
     const Real drag = 6 * pi * mu * R * V.norm();  // Stokes drag of a sphere at the same speed
     std::cout << std::scientific << std::setprecision(6) << "    V = (" << V[0] << ", " << V[1] << ", " << V[2]
               << ")   exact (1/3, 0, 0)\n    w = (" << w[0] << ", " << w[1] << ", " << w[2] << ")   exact 0\n"
@@ -419,9 +450,9 @@ int main(int argc, char** argv) try {
               << ", spurious max(|V_y|, |V_z|, |w|) = " << std::max({std::abs(V[1]), std::abs(V[2]), w.norm()}) << "\n"
               << "    stress integral over the walls: |F| / (6 pi mu R |V|) = " << walls.head<3>().norm() / drag
               << ", |T| / (6 pi mu R |V| H) = " << walls.tail<3>().norm() / (drag * H) << "\n";
-    write_flow_vtu(flow, o.output / "squirmer.vtu");
-    write_plane(flow, 8 * R, o.grid, o.output / "plane_squirmer_near.csv");
-    write_plane(flow, H, o.grid, o.output / "plane_squirmer_far.csv");
+    if (root) write_flow_vtu(flow, o.output / "squirmer.vtu");
+    if (root) write_plane(flow, 8 * R, o.grid, o.output / "plane_squirmer_near.csv");
+    if (root) write_plane(flow, H, o.grid, o.output / "plane_squirmer_far.csv");
     ds = decay_profile(flow, H);
     std::cout << "    output written: " << sw.lap() << "\n";
   }
@@ -431,20 +462,20 @@ int main(int argc, char** argv) try {
   if (o.translation) {
     Flow tr(mesh, stokes);
     configure(tr);
-    tr.set_velocity(tag_sphere, [&](const Vec<3>&, Real) { return V_exact; });
+    tr.set_velocity(tag_sphere, [&](const alefsi::Vec<3>&, Real) { return V_exact; });
     const StepReport rt = tr.step(1.0);
     std::cout << "translation at V_E (Dirichlet sphere): " << tr.space().n_field() << " field unknowns; "
               << std::defaultfloat << sw.lap() << "\n";
     print_report(rt);
-    const Vec<6> wt = surface_load(tr, tag_walls, mu);
+    const alefsi::Vec<6> wt = surface_load(tr, tag_walls, mu);
     std::cout << "    stress integral over the walls: F_x / (6 pi mu R V_E) = " << std::setprecision(4)
               << wt[0] / (6 * pi * mu * R * V_exact[0]) << " (the drag, passed on to the walls)\n";
-    write_flow_vtu(tr, o.output / "translation.vtu");
-    write_plane(tr, 8 * R, o.grid, o.output / "plane_translation_near.csv");
-    write_plane(tr, H, o.grid, o.output / "plane_translation_far.csv");
+    if (root) write_flow_vtu(tr, o.output / "translation.vtu");
+    if (root) write_plane(tr, 8 * R, o.grid, o.output / "plane_translation_near.csv");
+    if (root) write_plane(tr, H, o.grid, o.output / "plane_translation_far.csv");
     dt = decay_profile(tr, H);
   }
-  {
+  if (root) {
     std::ofstream out(o.output / "decay.csv");
     out << "r,squirmer_px,squirmer_mx,squirmer_py,squirmer_diag,squirmer_mean";
     if (o.translation) out << ",translation_px,translation_mx,translation_py,translation_diag,translation_mean";
@@ -462,5 +493,16 @@ int main(int argc, char** argv) try {
   return 0;
 } catch (const std::exception& e) {
   std::cerr << "sphere_squirmer: " << e.what() << "\n";
+#ifdef ALEFSI_SQUIRMER_PETSC
+  if (PetscSession::size() > 1) MPI_Abort(PETSC_COMM_WORLD, 1);  // the other ranks may wait for this one
+#endif
   return 1;
+}
+
+int main(int argc, char** argv) {
+#ifdef ALEFSI_SQUIRMER_PETSC
+  // outside squirmer_main's handler: PetscFinalize would wait for the other ranks before MPI_Abort
+  PetscSession petsc(argc, argv);
+#endif
+  return squirmer_main(argc, argv);
 }

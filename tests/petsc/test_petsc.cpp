@@ -77,7 +77,7 @@ alefsi::Vec<3> exact_f(const alefsi::Vec<3>& x) {
 }  // namespace
 
 TEST_CASE("PetscDirect (MUMPS) and PetscKrylov solve 3D Stokes (P2/P1, P1/P1-GLS) as the serial SparseLU does",
-          "[petsc][quick]") {
+          "[petsc][cavity][quick]") {
   for (int pair = 0; pair < 2; ++pair) {
     const auto s = pair == 0 ? cavity3d<TaylorHood>(6) : cavity3d<P1P1Gls>(8);
     const VecX reference = serial_solve(s.A, s.b);
@@ -105,7 +105,9 @@ TEST_CASE("PetscDirect (MUMPS) and PetscKrylov solve 3D Stokes (P2/P1, P1/P1-GLS
       std::cout << "PETSc GMRES+fieldsplit, " << (pair == 0 ? "P2/P1" : "P1/P1-GLS") << ", "
                 << (blocks ? "Schur ~ M_p/mu" : "Schur ~ selfp") << ": " << k.iterations() << " iterations, "
                 << s.A.rows() << " unknowns, " << PetscSession::size() << " rank(s)\n";
-      CHECK(relative_residual(s.A, x, s.b) <= 1e-11);
+      // GMRES stops on its recurrence's estimate of the residual; the computed one differs by
+      // rounding, a few percent of the tolerance at most
+      CHECK(relative_residual(s.A, x, s.b) <= 1.1e-11);
       // ||x - x*|| <= ||K^-1|| ||r||: the pinned-pressure system has ||K^-1|| ||K|| ~ 1e4 here
       CHECK((x - reference).norm() <= 1e-6 * reference.norm());
       check_ownership(k, s.A.rows());
@@ -130,6 +132,19 @@ TEST_CASE("PetscKrylov: bad input and a solve that cannot converge are typed err
                                         Catch::Contains("e-"));
   VecX wrong = VecX::Ones(3);
   CHECK_THROWS_AS(few.solve(wrong), InvalidArgument);
+  // a singular matrix: MUMPS's failure is a SolverError on every rank alike (the reason is
+  // agreed across ranks before anyone throws), not a hang
+  SparseMatrix singular(4, 4);
+  singular.insert(0, 0) = 1, singular.insert(1, 1) = 1, singular.insert(2, 2) = 1, singular.insert(3, 3) = 0;
+  singular.insert(2, 3) = 0, singular.insert(3, 2) = 0;
+  singular.makeCompressed();
+  PetscDirect lu;
+  CHECK_THROWS_AS(
+      [&] {
+        lu.factorize(singular);
+        return lu.solve(VecX::Ones(4));
+      }(),
+      Error);
 }
 
 TEST_CASE("3D Taylor–Hood solved through PetscKrylov converges at rates 3 / 2 with the serial errors",

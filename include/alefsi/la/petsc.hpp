@@ -14,12 +14,14 @@
 ///
 ///   PetscDirect      MUMPS LU (KSPPREONLY + PCLU); `direct = true`, so the flow's factorisation
 ///                    reuse (la/linear_solve.hpp) works with it.
-///   PetscKrylov<D>   GMRES, right-preconditioned (it monitors the true residual), restart 60,
+///   PetscKrylov<D>   GMRES, right-preconditioned (it stops on the unpreconditioned residual,
+///                    as GMRES's recurrence estimates it), restart 60,
 ///                    with PCFIELDSPLIT in Schur form (upper factorisation) on the split
 ///                    [u ∪ z | p] of a flow system (la/saddle_point_blocks.hpp: velocities, body
 ///                    unknowns, pressures): hypre BoomerAMG on split 0 (velocities and bodies), and
 ///                    for the Schur complement either the pressure mass matrix, -(M_p / mu + C),
-///                    with SSOR (steady Stokes, when the flow hands over its blocks) or PETSc's
+///                    with SSOR (steady Stokes: blocks given by `set_blocks` with
+///                    mass_coefficient 0, as an AleFlow with rho = 0 hands them over) or PETSc's
 ///                    -(B diag(A)^-1 B^T + C) ("selfp", the time-step regime where rho/dt
 ///                    dominates) with BoomerAMG.
 ///
@@ -37,9 +39,12 @@
 ///       ...
 ///     }
 ///
-/// Solvers must be destroyed before the session ends (declare the session first). PETSc errors
-/// and solves that do not converge throw `SolverError` naming the call, or the reason with the
-/// iterations and the residual.
+/// Solvers must be destroyed before the session ends (declare the session first). A solve that
+/// does not converge throws `SolverError` (PETSc's reason, the iterations, the residual) on every
+/// rank alike, so a driver may retry the step; a failed PETSc call throws `PetscError` (not a
+/// SolverError: a rank's PETSc objects may be half-built after it, and the other ranks may be
+/// waiting in a collective call; under MPI, catch it and call MPI_Abort). A new sparsity pattern
+/// is recognised (size, entries and a hash of the indices) and analysed again.
 #if !__has_include(<petscksp.h>)
 #error "alefsi/la/petsc.hpp needs PETSc: link the CMake target alefsi::petsc (apt install petsc-dev)"
 #endif
@@ -47,6 +52,8 @@
 #include <petscksp.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <type_traits>
 #include <cstdio>
 #include <set>
 #include <optional>
@@ -60,16 +67,33 @@
 #include "alefsi/la/saddle_point_blocks.hpp"
 #include "alefsi/la/solvers.hpp"
 
+static_assert(std::is_same_v<PetscScalar, double> && std::is_same_v<PetscReal, double>,
+              "alefsi/la/petsc.hpp needs PETSc's real double-precision build (Debian: petsc-dev's PETSc.pc)");
+
 namespace alefsi {
 
+/// A PETSc call failed (la/petsc.hpp): the call and PETSc's message.
+class PetscError : public Error {
+ public:
+  using Error::Error;
+};
+
 namespace detail {
-/// Throws SolverError naming `call` when a PETSc call failed.
+/// Throws PetscError naming `call` when a PETSc call failed.
 inline void petsc_check(PetscErrorCode code, const char* call) {
   if (code == 0) return;
   const char* text = nullptr;
   PetscErrorMessage(code, &text, nullptr);
-  throw SolverError(std::string("PETSc: ") + call + " failed (error " + std::to_string(int(code)) + ": " +
-                    (text ? text : "unknown") + ")");
+  throw PetscError(std::string("PETSc: ") + call + " failed (error " + std::to_string(int(code)) + ": " +
+                   (text ? text : "unknown") + ")");
+}
+/// A hash of a compressed matrix's pattern (its index arrays), to recognise a new pattern.
+inline std::uint64_t pattern_hash(const SparseMatrix& A) {
+  std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the indices
+  auto mix = [&h](Index v) { h = (h ^ std::uint64_t(std::uint32_t(v))) * 1099511628211ull; };
+  for (Index j = 0; j <= A.outerSize(); ++j) mix(A.outerIndexPtr()[j]);
+  for (Index k = 0; k < A.nonZeros(); ++k) mix(A.innerIndexPtr()[k]);
+  return h;
 }
 }  // namespace detail
 
@@ -117,14 +141,14 @@ class PetscSystem {
   explicit PetscSystem(std::string prefix) : prefix_(std::move(prefix)) {
     PetscBool up = PETSC_FALSE;
     PetscInitialized(&up);
-    if (!up) throw SolverError("PETSc solver created before PETSc was initialised (construct an alefsi::PetscSession first)");
+    if (!up) throw PetscError("PETSc solver created before PETSc was initialised (construct an alefsi::PetscSession first)");
   }
   PetscSystem(const PetscSystem&) = delete;
   PetscSystem& operator=(const PetscSystem&) = delete;
   ~PetscSystem() {
     PetscBool down = PETSC_FALSE;
     PetscFinalized(&down);
-    if (down) return;  // PETSc freed everything at PetscFinalize
+    if (down) return;  // too late to destroy PETSc objects: left to the process's exit
     destroy_pattern();
   }
 
@@ -135,13 +159,42 @@ class PetscSystem {
     ALEFSI_CHECK_ARG(A.rows() == A.cols(), "A", "must be square, got ", A.rows(), " x ", A.cols());
     ALEFSI_CHECK_ARG(A.isCompressed(), "A", "must be compressed (makeCompressed)");
     destroy_pattern();
+    try {
+      build(A);
+    } catch (...) {
+      destroy_pattern();  // nothing half-built: the next factorisation analyses again
+      throw;
+    }
+  }
+
+  /// Whether `A` has another pattern than the one analysed (or none was).
+  bool new_pattern(const SparseMatrix& A) const {
+    return !mat_ || A.rows() != n_ || A.nonZeros() != nnz_ || detail::pattern_hash(A) != hash_;
+  }
+
+  /// Copies A's values into the distributed matrix (a new pattern is analysed first) and sets
+  /// the KSP up: a numeric factorisation (MUMPS) or the preconditioner's set-up (BoomerAMG),
+  /// reusing the symbolic work of the same pattern.
+  void set_matrix(const SparseMatrix& A) {
+    ALEFSI_CHECK_ARG(A.isCompressed(), "A", "must be compressed (makeCompressed)");
+    if (new_pattern(A)) analyze(A);
+    const Real* v = A.valuePtr();
+    for (std::size_t e = 0; e < position_.size(); ++e) values_[e] = PetscScalar(v[position_[e]]);
+    ALEFSI_PETSC(MatSetValuesCOO(mat_, values_.data(), INSERT_VALUES));
+    ALEFSI_PETSC(KSPSetOperators(ksp_, mat_, mat_));
+  }
+  void setup() { ALEFSI_PETSC(KSPSetUp(ksp_)); }
+
+ private:
+  void build(const SparseMatrix& A) {
     n_ = A.rows();
     nnz_ = A.nonZeros();
+    hash_ = detail::pattern_hash(A);
     PetscInt local = PETSC_DECIDE, global = PetscInt(n_);
     ALEFSI_PETSC(PetscSplitOwnership(PETSC_COMM_WORLD, &local, &global));
     PetscInt end = 0;
     if (MPI_Scan(&local, &end, 1, MPIU_INT, MPI_SUM, PETSC_COMM_WORLD) != MPI_SUCCESS)
-      throw SolverError("PETSc: MPI_Scan of the row ranges failed");
+      throw PetscError("PETSc: MPI_Scan of the row ranges failed");
     row_begin_ = Index(end - local), row_end_ = Index(end);
     std::vector<PetscInt> ci, cj;
     position_.clear();
@@ -163,18 +216,7 @@ class PetscSystem {
     first_ = true;
   }
 
-  /// Copies A's values into the distributed matrix (A must have the analysed pattern; another
-  /// pattern is analysed first) and sets the KSP up: a numeric factorisation (MUMPS) or the
-  /// preconditioner's set-up (BoomerAMG), reusing the symbolic work of the same pattern.
-  void set_matrix(const SparseMatrix& A) {
-    if (!mat_ || A.rows() != n_ || A.nonZeros() != nnz_) analyze(A);
-    const Real* v = A.valuePtr();
-    for (std::size_t e = 0; e < position_.size(); ++e) values_[e] = PetscScalar(v[position_[e]]);
-    ALEFSI_PETSC(MatSetValuesCOO(mat_, values_.data(), INSERT_VALUES));
-    ALEFSI_PETSC(KSPSetOperators(ksp_, mat_, mat_));
-  }
-  void setup() { ALEFSI_PETSC(KSPSetUp(ksp_)); }
-
+ public:
   /// Solves with the KSP; `b` and the returned solution are whole (every rank's copy).
   VecX solve(const VecX& b) {
     ALEFSI_CHECK_ARG(b.size() == n_, "b", "has ", b.size(), " entries, the matrix ", n_, " rows");
@@ -183,8 +225,13 @@ class PetscSystem {
     for (Index i = row_begin_; i < row_end_; ++i) pb[i - row_begin_] = b[i];
     ALEFSI_PETSC(VecRestoreArray(b_, &pb));
     ALEFSI_PETSC(KSPSolve(ksp_, b_, x_));
-    KSPConvergedReason reason;
-    ALEFSI_PETSC(KSPGetConvergedReason(ksp_, &reason));
+    KSPConvergedReason local;
+    ALEFSI_PETSC(KSPGetConvergedReason(ksp_, &local));
+    // a failed preconditioner may be flagged on some ranks only: agree before throwing
+    int r = int(local), reason_all = 0;
+    if (MPI_Allreduce(&r, &reason_all, 1, MPI_INT, MPI_MIN, PETSC_COMM_WORLD) != MPI_SUCCESS)
+      throw PetscError("PETSc: MPI_Allreduce of the converged reason failed");
+    const auto reason = KSPConvergedReason(reason_all);
     PetscInt its = 0;
     ALEFSI_PETSC(KSPGetIterationNumber(ksp_, &its));
     iterations_ = int(its);
@@ -213,10 +260,19 @@ class PetscSystem {
   Index row_end() const { return row_end_; }
   int iterations() const { return iterations_; }
   const std::string& prefix() const { return prefix_; }
+  /// The value of `-<prefix><name>` in the options database ("" when unset).
+  std::string option(const std::string& name) const {
+    char value[256] = "";
+    PetscBool set = PETSC_FALSE;
+    ALEFSI_PETSC(PetscOptionsGetString(nullptr, nullptr, ("-" + prefix_ + name).c_str(), value, sizeof value, &set));
+    return set ? std::string(value) : std::string();
+  }
   /// True once after each analysis: the KSP's type and options are set then.
   bool take_first() { return std::exchange(first_, false); }
-  /// Sets `-<prefix><name> value` in the options database unless the user gave that option
-  /// (an option a solver set before is a default, not the user's: it is set again).
+  /// Sets `-<prefix><name> value` in PETSc's (global) options database unless the user gave that
+  /// option (an option a solver set before is a default, not the user's: it is set again, so a
+  /// value set in code after a solver's default is overwritten at that solver's next analysis;
+  /// pass such settings on the command line, in PETSC_OPTIONS or with another prefix).
   void default_option(const char* name, const char* value) const {
     static std::set<std::string> defaults;  // the options solvers set, not the user
     const std::string key = "-" + prefix_ + name;
@@ -229,6 +285,7 @@ class PetscSystem {
 
  private:
   void destroy_pattern() {
+    n_ = nnz_ = 0;
     if (ksp_) KSPDestroy(&ksp_);
     if (gather_) VecScatterDestroy(&gather_);
     if (x_all_) VecDestroy(&x_all_);
@@ -243,6 +300,7 @@ class PetscSystem {
   ::Vec x_ = nullptr, b_ = nullptr, x_all_ = nullptr;
   VecScatter gather_ = nullptr;
   Index n_ = 0, nnz_ = 0, row_begin_ = 0, row_end_ = 0;
+  std::uint64_t hash_ = 0;
   std::vector<Index> position_;       // value-array positions of this rank's entries (COO order)
   std::vector<PetscScalar> values_;  // their values, in COO order
   int iterations_ = 0;
@@ -307,14 +365,18 @@ class PetscKrylov {
   PetscKrylov& operator=(const PetscKrylov&) = delete;
 
   /// The space's blocks (la/saddle_point_blocks.hpp; optional): the split sizes, and the pressure
-  /// mass matrix for the Schur complement of steady Stokes. Takes effect at the next
-  /// `factorize`.
+  /// mass matrix for the Schur complement of steady Stokes (mass_coefficient 0). Takes effect at
+  /// the next `factorize`. Blocks that change only the time-step mass (a flow's gamma, at every
+  /// change of dt) keep the analysis and the KSP.
   void set_blocks(SaddlePointBlocks blocks) {
+    const bool same = analyzed_ && !use_mass_ && !mass_path(blocks) && blocks.n_pressure == split_.n_pressure &&
+                      blocks.n_extra == split_.n_extra;
     blocks_ = std::move(blocks);
-    analyzed_ = false;
+    if (!same) analyzed_ = false;
   }
 
   void analyze(const SparseMatrix& A) {
+    analyzed_ = false;
     split_ = saddle_point_split(A, blocks_ ? &*blocks_ : nullptr, name);
     sys_.analyze(A);
     // this rank's rows of split 0 (velocities [0, nu) and bodies [nu + np, n)) and of split 1
@@ -329,10 +391,16 @@ class PetscKrylov {
   }
 
   void factorize(const SparseMatrix& A) {
-    if (!analyzed_ || A.rows() != sys_.rows()) analyze(A);
+    if (!analyzed_ || sys_.new_pattern(A)) analyze(A);
     sys_.set_matrix(A);
     if (sys_.take_first()) configured_ = false;
-    if (!configured_) configure(A);
+    try {
+      if (!configured_) configure(A);
+      else if (use_mass_) set_schur_values(A);  // its -C part follows the matrix
+    } catch (...) {
+      analyzed_ = false;  // a half-configured preconditioner: a new KSP at the next factorize
+      throw;
+    }
     sys_.setup();
   }
   VecX solve(const VecX& b) { return sys_.solve(b); }
@@ -361,7 +429,7 @@ class PetscKrylov {
     ALEFSI_PETSC(PCFieldSplitSetIS(pc, "1", is1_));
     ALEFSI_PETSC(PCFieldSplitSetType(pc, PC_COMPOSITE_SCHUR));
     ALEFSI_PETSC(PCFieldSplitSetSchurFactType(pc, PC_FIELDSPLIT_SCHUR_FACT_UPPER));
-    use_mass_ = blocks_ && blocks_->pressure_mass.rows() == split_.n_pressure && blocks_->mass_coefficient == 0;
+    use_mass_ = blocks_ && mass_path(*blocks_);
     if (use_mass_) {
       set_schur_matrix(A);
       ALEFSI_PETSC(PCFieldSplitSetSchurPre(pc, PC_FIELDSPLIT_SCHUR_PRE_USER, schur_pre_));
@@ -373,7 +441,9 @@ class PetscKrylov {
     // P2/P1 cavity (docs/performance.md, "PETSc and MPI")
     auto boomeramg = [&](const std::string& split, const char* strength) {
       sys_.default_option((split + "pc_type").c_str(), "hypre");
+      if (sys_.option(split + "pc_type") != "hypre") return;  // the user chose another
       sys_.default_option((split + "pc_hypre_type").c_str(), "boomeramg");
+      if (sys_.option(split + "pc_hypre_type") != "boomeramg") return;
       sys_.default_option((split + "pc_hypre_boomeramg_coarsen_type").c_str(), "HMIS");
       sys_.default_option((split + "pc_hypre_boomeramg_interp_type").c_str(), "ext+i");
       sys_.default_option((split + "pc_hypre_boomeramg_P_max").c_str(), "4");
@@ -392,26 +462,42 @@ class PetscKrylov {
   // S~ = -C - M_p / mu (PETSc's Schur complement is A_pp - B A^-1 B^T, negative: A_pp = -C),
   // this rank's pressure rows, in the numbering of split 1 (PETSc numbers a split's unknowns in
   // rank order: this rank's pressures are contiguous there).
-  void set_schur_matrix(const SparseMatrix& A) {
+  bool mass_path(const SaddlePointBlocks& b) const {
+    return b.mass_coefficient == 0 && b.pressure_mass.rows() == b.n_pressure && b.n_pressure > 0;
+  }
+  // Visits this rank's entries of S~ (its pressure rows, in the order set_schur_matrix and
+  // set_schur_values share): f(i, j, value) with i, j in split 1's numbering.
+  template <class F>
+  void schur_entries(const SparseMatrix& A, F&& f) const {
     const SparseMatrix& Mp = blocks_->pressure_mass;
     const Index p0 = split_.n_velocity, np = split_.n_pressure;
     const Index lo = std::clamp(sys_.row_begin() - p0, Index(0), np), hi = std::clamp(sys_.row_end() - p0, Index(0), np);
-    std::vector<PetscInt> ci, cj;
-    std::vector<PetscScalar> v;
-    auto add = [&](Index i, Index j, Real value) {
-      if (i >= lo && i < hi) ci.push_back(PetscInt(i)), cj.push_back(PetscInt(j)), v.push_back(PetscScalar(value));
-    };
     for (Index j = 0; j < np; ++j) {
-      for (SparseMatrix::InnerIterator it(Mp, j); it; ++it) add(it.row(), j, -it.value() / blocks_->mu);
+      for (SparseMatrix::InnerIterator it(Mp, j); it; ++it)
+        if (it.row() >= lo && it.row() < hi) f(it.row(), j, -it.value() / blocks_->mu);
       for (SparseMatrix::InnerIterator it(A, p0 + j); it; ++it)  // COO sums repeated entries
-        if (it.row() >= p0 && it.row() < p0 + np) add(it.row() - p0, j, it.value());
+        if (it.row() >= p0 + lo && it.row() < p0 + hi) f(it.row() - p0, j, it.value());
     }
+  }
+  // S~ = -C - M_p / mu (PETSc's Schur complement is A_pp - B A^-1 B^T, negative: A_pp = -C),
+  // this rank's pressure rows, in the numbering of split 1 (PETSc numbers a split's unknowns in
+  // rank order: this rank's pressures are contiguous there).
+  void set_schur_matrix(const SparseMatrix& A) {
+    const Index p0 = split_.n_velocity, np = split_.n_pressure;
+    const Index lo = std::clamp(sys_.row_begin() - p0, Index(0), np), hi = std::clamp(sys_.row_end() - p0, Index(0), np);
+    std::vector<PetscInt> ci, cj;
+    schur_entries(A, [&](Index i, Index j, Real) { ci.push_back(PetscInt(i)), cj.push_back(PetscInt(j)); });
     if (schur_pre_) MatDestroy(&schur_pre_);
     ALEFSI_PETSC(MatCreate(PETSC_COMM_WORLD, &schur_pre_));
     ALEFSI_PETSC(MatSetSizes(schur_pre_, PetscInt(hi - lo), PetscInt(hi - lo), PetscInt(np), PetscInt(np)));
     ALEFSI_PETSC(MatSetType(schur_pre_, MATAIJ));
     ALEFSI_PETSC(MatSetPreallocationCOO(schur_pre_, PetscCount(ci.size()), ci.data(), cj.data()));
-    ALEFSI_PETSC(MatSetValuesCOO(schur_pre_, v.data(), INSERT_VALUES));
+    set_schur_values(A);
+  }
+  void set_schur_values(const SparseMatrix& A) {
+    schur_values_.clear();
+    schur_entries(A, [&](Index, Index, Real v) { schur_values_.push_back(PetscScalar(v)); });
+    ALEFSI_PETSC(MatSetValuesCOO(schur_pre_, schur_values_.data(), INSERT_VALUES));
   }
   void destroy_splits() {
     PetscBool down = PETSC_FALSE;
@@ -428,6 +514,7 @@ class PetscKrylov {
   SaddlePointSplit split_;
   IS is0_ = nullptr, is1_ = nullptr;
   ::Mat schur_pre_ = nullptr;
+  std::vector<PetscScalar> schur_values_;
   bool analyzed_ = false, configured_ = false, use_mass_ = false;
 };
 

@@ -5,13 +5,21 @@
 /// solves A P^-1 y = b, x = P^-1 y, from x = 0, with modified Gram–Schmidt Arnoldi and Givens
 /// rotations, and stops when the true residual ||b - A x||_2 <= tolerance ||b||_2 (checked at
 /// each restart; within a cycle the rotated residual decides) or after max_iterations
-/// applications of A. It does not throw: the caller decides what a miss means
+/// applications of the preconditioner. It does not throw: the caller decides what a miss means
 /// (`SaddlePointGmres` throws SolverError; `LinearSolve` refactorises, sim/newton.hpp).
+///
+/// With `augment = k > 0` it is LGMRES(m, k) (Baker, Jessup & Manteuffel, SIAM J. Matrix Anal.
+/// Appl. 26 (2005) 962): each cycle's search space is the m Krylov directions plus the k latest
+/// cycle corrections z_j = x_j - x_{j-1}. A restart otherwise forgets the slow error components
+/// that earlier cycles had found, and the residual then falls by a constant factor per cycle
+/// (it did for a free sphere on a graded mesh, docs/solvers.md); the corrections keep them. Cost:
+/// 2k more vectors, k products with A per cycle, no more preconditioner applications.
 ///
 ///     GmresWork work;
 ///     GmresResult res = gmres(A, b, [&](const VecX& v) { return lu.solve(v); }, {.tolerance = 1e-12}, x, work);
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "alefsi/core/eigen_sparse.hpp"
 #include "alefsi/core/types.hpp"
@@ -21,18 +29,20 @@ namespace alefsi {
 struct GmresOptions {
   Real tolerance = 1e-8;      ///< on ||b - A x||_2 / ||b||_2
   int max_iterations = 1000;  ///< applications of A (and of the preconditioner)
-  int restart = 60;           ///< Krylov vectors kept (memory: restart + 1 vectors)
+  int restart = 60;           ///< Krylov vectors per cycle (memory: restart + 1 vectors)
+  int augment = 0;            ///< LGMRES: earlier cycle corrections kept (memory: 2 augment vectors more)
 };
 
 struct GmresResult {
-  int iterations = 0;     ///< applications of A
+  int iterations = 0;     ///< applications of the preconditioner (Krylov steps)
   Real residual = 0;      ///< ||b - A x|| / ||b|| at the end (0 for b = 0)
   bool converged = false;
 };
 
-/// The Krylov basis, kept between calls so that repeated solves do not reallocate it.
+/// The Krylov basis and the LGMRES corrections, kept between calls so that repeated solves do
+/// not reallocate them.
 struct GmresWork {
-  MatX V;
+  MatX V, Z;
 };
 
 /// x = the GMRES iterate for A x = b (A: any matrix with A * VecX, e.g. SparseMatrix),
@@ -41,7 +51,7 @@ template <class Matrix, class Precondition>
 GmresResult gmres(const Matrix& A, const VecX& b, Precondition&& precondition, const GmresOptions& opt, VecX& x,
                   GmresWork& work) {
   const Index n = b.size();
-  const int m = std::max(1, opt.restart);
+  const int m = std::max(1, opt.restart), k_aug = std::max(0, opt.augment);
   GmresResult res;
   x = VecX::Zero(n);
   const Real bnorm = b.norm();
@@ -51,9 +61,12 @@ GmresResult gmres(const Matrix& A, const VecX& b, Precondition&& precondition, c
   }
   const Real target = opt.tolerance * bnorm;
   MatX& V = work.V;
-  if (V.cols() != m + 1 || V.rows() != n) V.resize(n, m + 1);
-  MatX H = MatX::Zero(m + 1, m);
-  VecX g(m + 1), cs(m), sn(m), w(n);
+  MatX& Z = work.Z;  // unit corrections of the latest cycles, newest first
+  if (V.cols() != m + k_aug + 1 || V.rows() != n) V.resize(n, m + k_aug + 1);
+  if (Z.cols() != k_aug || Z.rows() != n) Z.resize(n, k_aug);
+  int n_z = 0;  // corrections stored so far (< k_aug in the first cycles)
+  MatX H = MatX::Zero(m + k_aug + 1, m + k_aug);
+  VecX g(m + k_aug + 1), cs(m + k_aug), sn(m + k_aug), w(n);
   VecX r = b;
   Real rnorm = bnorm;
   while (rnorm > target && res.iterations < opt.max_iterations) {
@@ -62,13 +75,19 @@ GmresResult gmres(const Matrix& A, const VecX& b, Precondition&& precondition, c
     g[0] = rnorm;
     H.setZero();
     int k = 0;
-    while (k < m && res.iterations < opt.max_iterations) {
-      w.noalias() = A * precondition(VecX(V.col(k)));
+    // one Arnoldi step on the new direction w = A q (q: P^-1 v_k or a stored correction);
+    // `optional`: a correction (nearly) in the space already is left out, not added
+    auto arnoldi = [&](bool optional) {
+      const Real wnorm = w.norm();
       for (int i = 0; i <= k; ++i) {  // modified Gram–Schmidt
         H(i, k) = w.dot(V.col(i));
         w.noalias() -= H(i, k) * V.col(i);
       }
       H(k + 1, k) = w.norm();
+      if (optional && !(H(k + 1, k) > 1e-10 * wnorm)) {
+        H.col(k).setZero();
+        return false;
+      }
       if (H(k + 1, k) > 0) V.col(k + 1) = w / H(k + 1, k);
       for (int i = 0; i < k; ++i) {  // earlier rotations
         const Real t = cs[i] * H(i, k) + sn[i] * H(i + 1, k);
@@ -83,11 +102,35 @@ GmresResult gmres(const Matrix& A, const VecX& b, Precondition&& precondition, c
       g[k + 1] = -sn[k] * g[k];
       g[k] = cs[k] * g[k];
       ++k;
+      return std::abs(g[k]) <= target;
+    };
+    bool done = false;
+    while (!done && k < m && res.iterations < opt.max_iterations) {
+      w.noalias() = A * precondition(VecX(V.col(k)));
       ++res.iterations;
-      if (std::abs(g[k]) <= target) break;
+      done = arnoldi(false);
     }
+    const int n_krylov = k;
+    std::vector<int> used;  // the corrections added, in the order of their columns
+    if (n_krylov == m)  // a full cycle: add the stored corrections to the search space
+      for (int j = 0; j < n_z && !done; ++j) {
+        w.noalias() = A * Z.col(j);
+        const int k0 = k;
+        done = arnoldi(true);
+        if (k > k0) used.push_back(j);
+      }
     const VecX y = H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
-    x.noalias() += precondition(VecX(V.leftCols(k) * y));
+    VecX dx = precondition(VecX(V.leftCols(n_krylov) * y.head(n_krylov)));
+    for (std::size_t j = 0; j < used.size(); ++j) dx.noalias() += y[n_krylov + Index(j)] * Z.col(used[j]);
+    x += dx;
+    if (k_aug > 0) {  // newest correction first, the oldest dropped
+      const Real dnorm = dx.norm();
+      if (dnorm > 0) {
+        for (int j = std::min(n_z, k_aug - 1); j > 0; --j) Z.col(j) = Z.col(j - 1);
+        Z.col(0) = dx / dnorm;
+        n_z = std::min(n_z + 1, k_aug);
+      }
+    }
     r.noalias() = b - A * x;
     rnorm = r.norm();
   }

@@ -64,6 +64,7 @@ struct KrylovOptions {
   Real tolerance = 1e-8;     ///< on ||b - K x|| / ||b||
   int max_iterations = 1000;
   int restart = 60;          ///< GMRES restart length (memory: restart + 1 vectors)
+  int augment = 2;           ///< LGMRES corrections kept across restarts (la/gmres.hpp; 2 vectors each)
   int mass_steps = 3;        ///< Jacobi–Chebyshev steps for M_p^-1 (explicit blocks)
   int velocity_cycles = 1;   ///< AMG V-cycles per velocity solve (stationary iteration: linear)
   AmgOptions amg = {};       ///< velocity block (and Cahouet–Chabard Laplacian) AMG
@@ -81,6 +82,7 @@ class SaddlePointGmres {
     ALEFSI_CHECK_ARG(opt.tolerance > 0 && opt.tolerance < 1, "tolerance", "must be in (0, 1), got ", opt.tolerance);
     ALEFSI_CHECK_ARG(opt.max_iterations >= 1, "max_iterations", "must be positive");
     ALEFSI_CHECK_ARG(opt.restart >= 1, "restart", "must be positive");
+    ALEFSI_CHECK_ARG(opt.augment >= 0, "augment", "must be non-negative");
     ALEFSI_CHECK_ARG(opt.mass_steps >= 1, "mass_steps", "must be positive");
     ALEFSI_CHECK_ARG(opt.velocity_cycles >= 1, "velocity_cycles", "must be positive");
   }
@@ -199,7 +201,9 @@ class SaddlePointGmres {
     VecX x;
     const GmresResult res = gmres(
         *A_, b, [this](const VecX& v) { return precondition(v); },
-        {.tolerance = opt_.tolerance, .max_iterations = opt_.max_iterations, .restart = opt_.restart}, x, work_);
+        {.tolerance = opt_.tolerance, .max_iterations = opt_.max_iterations, .restart = opt_.restart,
+         .augment = opt_.augment},
+        x, work_);
     iterations_ = res.iterations, residual_ = res.residual;
     if (!res.converged)
       throw SolverError(std::string(name) + " did not converge: " + std::to_string(res.iterations) +

@@ -1,10 +1,11 @@
 #pragma once
 /// \file scenes.hpp
 /// Ready-made scenes (meshes, bodies, boundary data) shared by the examples, tests and
-/// benchmarks: the paper's annulus and settling disks, the DFG cylinder, the oscillating cylinder
-/// and an ellipse in simple shear (Jeffery's orbit).
+/// benchmarks: the paper's annulus and settling disks, the DFG cylinder, the oscillating cylinder,
+/// an ellipse in simple shear (Jeffery's orbit) and a sphere settling in a spherical container (3D).
 #include "alefsi/scenes/annulus.hpp"
 #include "alefsi/scenes/dfg.hpp"
 #include "alefsi/scenes/jeffery.hpp"
 #include "alefsi/scenes/oscillating_cylinder.hpp"
 #include "alefsi/scenes/settling.hpp"
+#include "alefsi/scenes/settling_sphere.hpp"

@@ -12,6 +12,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <numbers>
 #include <string>
@@ -22,8 +24,11 @@
 #include "alefsi/la/petsc.hpp"
 #include "alefsi/la/solvers.hpp"
 #include "alefsi/mesh/io/gmsh.hpp"
+#include "alefsi/la/krylov.hpp"
 #include "alefsi/physics/stokes.hpp"
+#include "alefsi/scenes/settling_sphere.hpp"
 #include "alefsi/sim/ale_flow.hpp"
+#include "alefsi/sim/driver.hpp"
 
 using namespace alefsi;
 using alefsi::testing::cavity3d;
@@ -199,6 +204,73 @@ TEST_CASE("AleFlow with PetscKrylov<3> or PetscDirect: 3D Navier–Stokes steps 
   CHECK((krylov.body_velocity(0) - serial.body_velocity(0)).norm() <= 1e-7 * serial.body_velocity(0).norm());
   CHECK((direct.field() - u0).norm() <= 1e-10 * u0.norm());
   CHECK((direct.body_velocity(0) - serial.body_velocity(0)).norm() <= 1e-10 * serial.body_velocity(0).norm());
+}
+
+TEST_CASE("a sphere settling in a spherical container: 10 steps through run() on N ranks follow the serial "
+          "trajectory, rank 0 writes, and its checkpoint continues in a serial flow",
+          "[petsc][settling][quick]") {
+  // examples/sphere_settling.cpp's scene: Navier–Stokes, a free sphere under gravity, the mesh
+  // moved by elasticity. Every rank runs the PETSc flow through the driver (rank 0 writing into
+  // one shared folder), then the serial flow with SaddlePointGmres, and compares the two
+  // trajectories step by step. Newton (to 1e-10) removes the solvers' differences (1e-8).
+  const scenes::SettlingSphere scene;
+  const Real dt = 0.005;
+  const int steps = 10;
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("alefsi_test_settling_" + std::to_string(PetscSession::size()) + "_ranks");
+  if (PetscSession::rank() == 0) std::filesystem::remove_all(dir);
+  MPI_Barrier(PETSC_COMM_WORLD);
+  auto trajectory = [&](auto& flow, RunOptions opt) {
+    std::vector<alefsi::Vec<3>> centre;
+    std::vector<alefsi::Vec<6>> velocity;
+    opt.dt = dt, opt.tolerance = 0, opt.log = nullptr;
+    opt.on_step = [&] {
+      centre.push_back(flow.body_centre(0));
+      velocity.push_back(flow.body_velocity(0));
+    };
+    run(flow, opt);
+    return std::pair(centre, velocity);
+  };
+  using Cfg = FlowConfig<3, TaylorHood, BDF2_BDF2E, NavierStokes>;
+  AleFlow<Cfg::with_solver<PetscKrylov<3>>> distributed(scene.mesh(), scene.flow_options());
+  scene.configure(distributed);
+  RunOptions opt;
+  opt.t_end = steps * dt, opt.output = dir, opt.checkpoint_every = steps / 2, opt.writer = PetscSession::rank() == 0;
+  const auto [x_mpi, v_mpi] = trajectory(distributed, opt);
+  MPI_Barrier(PETSC_COMM_WORLD);  // rank 0's files are complete
+
+  AleFlow<Cfg::with_solver<SaddlePointGmres<3>>> serial(scene.mesh(), scene.flow_options());
+  scene.configure(serial);
+  RunOptions serial_opt;
+  serial_opt.t_end = steps * dt;
+  const auto [x, v] = trajectory(serial, serial_opt);
+  REQUIRE(x_mpi.size() == std::size_t(steps));
+  REQUIRE(x.size() == std::size_t(steps));
+  const Real depth = std::abs(x.back()[2]), speed = v.back().norm();
+  CHECK(depth > 0.02);  // it has moved: 0.024 cm down at t = 0.05
+  for (int n = 0; n < steps; ++n) {
+    CHECK((x_mpi[std::size_t(n)] - x[std::size_t(n)]).norm() <= 1e-9 * depth);
+    CHECK((v_mpi[std::size_t(n)] - v[std::size_t(n)]).norm() <= 1e-9 * speed);
+  }
+  // rank 0's time series: a header and one row per step
+  {
+    std::ifstream csv(dir / "bodies.csv");
+    int lines = 0;
+    for (std::string line; std::getline(csv, line);) ++lines;
+    CHECK(lines == steps + 1);
+  }
+  // the checkpoint of step 10 (written by rank 0 under N ranks), continued serially for 2 steps,
+  // is the N-rank run continued (the state is the same on every rank)
+  const auto file = dir / "checkpoint.bin";
+  AleFlow<Cfg::with_solver<SaddlePointGmres<3>>> continued(read_checkpoint_mesh<3>(file), scene.flow_options());
+  scene.configure(continued);
+  continued.load_checkpoint(file);
+  CHECK(continued.time() == Approx(steps * dt));
+  CHECK((continued.body_centre(0) - x_mpi.back()).norm() == 0);
+  continued.step(dt), serial.step(dt);
+  CHECK((continued.body_centre(0) - serial.body_centre(0)).norm() <= 1e-9 * depth);
+  MPI_Barrier(PETSC_COMM_WORLD);
+  if (PetscSession::rank() == 0) std::filesystem::remove_all(dir);
 }
 
 // Catch2 reads the arguments before "--"; PETSc reads them all (its options go after "--").

@@ -45,6 +45,7 @@
 ///    dropping rows later than the restart time, and starts a new PVD series
 ///    `flow_from_<step>.pvd`.
 ///  * a progress line every `progress_every` steps (and at the end) on `log`.
+///  * under MPI: only the process with `writer` set writes files and lines (rank 0).
 ///
 ///     alefsi::RunOptions opt{.dt = 1e-3, .t_end = 0.5, .output = "out", .vtu_every = 50};
 ///     alefsi::RunSummary s = alefsi::run(flow, opt);
@@ -99,6 +100,11 @@ struct RunOptions {
   int recover_after = 20;           ///< good steps before trying a larger dt again
   Real absorb = 0.1;                ///< a remainder up to absorb * dt joins the last step; in [0, 1)
   std::ostream* log = &std::cout;   ///< progress and remarks; nullptr: silent
+  /// Whether this process writes the files and the log. Under MPI with the shared-mesh model
+  /// (la/petsc.hpp) every rank holds the whole state: rank 0 writes (`PetscSession::rank() ==
+  /// 0`), the others step in lockstep and write nothing. A checkpoint is then the same on any
+  /// number of ranks and restarts on any other.
+  bool writer = true;
   /// Called after every accepted step (e.g. extra monitoring); may throw to stop the run.
   std::function<void()> on_step = {};
 
@@ -209,12 +215,15 @@ inline void truncate_csv_after(const std::filesystem::path& file, Real t) {
 }  // namespace detail
 
 template <class Flow>
-RunSummary run(Flow& flow, const RunOptions& opt) {
-  opt.validate();
-  ALEFSI_CHECK_ARG(opt.t_end > flow.time(), "t_end", "must exceed the flow's time ", flow.time(), ", got ", opt.t_end);
+RunSummary run(Flow& flow, const RunOptions& options) {
+  options.validate();
+  ALEFSI_CHECK_ARG(options.t_end > flow.time(), "t_end", "must exceed the flow's time ", flow.time(), ", got ",
+                   options.t_end);
   flow.prepare();  // a scene that cannot run is refused before anything is written
-  ALEFSI_CHECK_ARG(opt.checkpoint_every == 0 || opt.output.empty() || !flow.geometry(), "checkpoint_every",
+  ALEFSI_CHECK_ARG(options.checkpoint_every == 0 || options.output.empty() || !flow.geometry(), "checkpoint_every",
                    "flows with curved boundaries cannot be checkpointed yet: set it to 0");
+  RunOptions opt = options;  // (every check above is made on every rank: they all stop together)
+  if (!opt.writer) opt.output.clear(), opt.log = nullptr;
   const auto wall0 = std::chrono::steady_clock::now();
   auto wall = [&] { return std::chrono::duration<Real>(std::chrono::steady_clock::now() - wall0).count(); };
   const std::size_t nb = flow.n_bodies();

@@ -1,0 +1,141 @@
+// sphere_settling — a sphere settling from the centre of a closed spherical container, in 3D:
+// Navier–Stokes, Taylor–Hood, BDF2/BDF2E, the sphere free in 6 degrees of freedom under gravity,
+// the mesh moved by elasticity (scenes/settling_sphere.hpp). The same program runs on one core
+// with alefsi's own iterative solver, or under mpirun with PETSc's: one type differs.
+//
+// What it shows: the sphere (a = 0.25 cm, rho_s = 1.5 g/cm^3) starts at rest at the centre of
+// a container of radius 2 cm filled with a viscous fluid (rho_f = 1, mu = 10 P), accelerates and
+// approaches its terminal speed; at Re = 0.025 that is the creeping-flow speed with the
+// concentric-spheres wall factor K(a / b) (Haberman & Sayre 1958), U = 4.925 / mu cm/s. It
+// drifts a little below the centre meanwhile (0.05 cm by t = 0.1 s), which changes the drag
+// by a small amount.
+//
+// How to run: ./sphere_settling [--layers 2] [--grading 2] [--dt 0.005] [--t-end 0.1]
+//             [--mu 10] [--output DIR] [--vtu-every 0] [--checkpoint-every 0] [--restart]
+//             (`--help` lists the options). --restart continues from DIR/checkpoint.bin (with
+//             the same options; on any number of ranks).
+// What it prints: the mesh and unknowns, a progress line every 10 steps, then the sphere's
+// depth and velocity at t_end against the terminal speed, the solver's iterations, the wall and
+// CPU times and the peak memory. It writes DIR/bodies.csv (one row per step: centre,
+// orientation, velocity, hydrodynamic load), DIR/flow.pvd with its VTU files (--vtu-every)
+// and DIR/checkpoint.bin (--checkpoint-every), through alefsi::run (sim/driver.hpp).
+//
+// Under MPI (target sphere_settling_mpi, built when alefsi::petsc is found): the solver type is
+// alefsi::PetscKrylov<3> (GMRES, fieldsplit Schur, BoomerAMG on the velocities) instead of
+// alefsi::SaddlePointGmres<3>:
+//   mpirun -n 2 ./sphere_settling_mpi [options as above] [-- PETSc options, e.g. -ksp_monitor]
+// Every rank holds the mesh and the whole state; the solves are distributed; rank 0 prints and
+// writes. The trajectory is the serial one to the solvers' tolerance (docs/performance.md).
+// (PETSc's C types Vec and Mat are global: this file spells alefsi::Vec out.)
+#include <alefsi/alefsi.hpp>
+#include <alefsi/app.hpp>
+#include <alefsi/la/krylov.hpp>
+#ifdef ALEFSI_SETTLING_PETSC
+#include <alefsi/la/petsc.hpp>
+#endif
+
+#include <sys/resource.h>
+
+#include <chrono>
+#include <ctime>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <string>
+
+using namespace alefsi;
+
+#ifdef ALEFSI_SETTLING_PETSC
+using Solver = PetscKrylov<3>;
+#else
+using Solver = SaddlePointGmres<3>;
+#endif
+using Flow = AleFlow<FlowConfig<3, TaylorHood, BDF2_BDF2E, NavierStokes, Solver>>;
+
+namespace {
+
+struct Settings {
+  scenes::SettlingSphere scene;
+  Real dt = 0.005, t_end = 0.1;
+  int vtu_every = 0, checkpoint_every = 0;
+  bool restart = false;
+  std::filesystem::path output = "sphere_settling_out";
+};
+
+bool parse(int argc, char** argv, Settings& o) {
+  Options opt("sphere_settling", "A sphere settling from the centre of a spherical container (3D, Navier–Stokes).");
+  opt.add("layers", o.scene.layers, "cell layers across the gap (336 layers^3 tetrahedra)")
+      .add("grading", o.scene.grading, "pull of the layers towards the sphere (1: none)")
+      .add("mu", o.scene.mu, "viscosity (P)")
+      .add("dt", o.dt, "time step (s)")
+      .add("t-end", o.t_end, "end time (s)")
+      .add("output", o.output, "folder for bodies.csv, VTU and checkpoints")
+      .add("vtu-every", o.vtu_every, "a VTU file every this many steps (0: none)")
+      .add("checkpoint-every", o.checkpoint_every, "a checkpoint every this many steps (0: only with --restart)")
+      .flag("restart", o.restart, "continue from <output>/checkpoint.bin");
+  return opt.parse(argc, argv, std::cout);
+}
+
+Real cpu_seconds() { return Real(std::clock()) / CLOCKS_PER_SEC; }
+Real peak_mb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return Real(u.ru_maxrss) / 1024;
+}
+
+}  // namespace
+
+int settling_main(int argc, char** argv) try {
+#ifdef ALEFSI_SETTLING_PETSC
+  for (int i = 1; i < argc; ++i)  // PETSc's options: after "--"
+    if (std::string(argv[i]) == "--") argc = i;
+  const bool root = PetscSession::rank() == 0;
+  if (!root) std::cout.rdbuf(nullptr);  // rank 0 prints
+#else
+  const bool root = true;
+#endif
+  Settings o;
+  if (!parse(argc, argv, o)) return 0;
+  const auto wall0 = std::chrono::steady_clock::now();
+  const Real cpu0 = cpu_seconds();
+  const scenes::SettlingSphere& scene = o.scene;
+  const auto checkpoint = o.output / "checkpoint.bin";
+  Flow flow(o.restart ? read_checkpoint_mesh<3>(checkpoint) : scene.mesh(), scene.flow_options());
+  scene.configure(flow);
+  if (o.restart) flow.load_checkpoint(checkpoint);
+  std::cout << "sphere_settling (" << Solver::name << "): " << flow.mesh().n_cells() << " tetrahedra, "
+            << flow.space().n_field() + Flow::body_dofs << " unknowns; a = " << scene.a << ", b = " << scene.b
+            << ", mu = " << scene.mu << "; from t = " << flow.time() << " to " << o.t_end << " in steps of " << o.dt
+            << "\n";
+  RunOptions run_opt;
+  run_opt.dt = o.dt, run_opt.t_end = o.t_end, run_opt.tolerance = 0;  // fixed steps
+  run_opt.output = o.output, run_opt.vtu_every = o.vtu_every, run_opt.checkpoint_every = o.checkpoint_every;
+  run_opt.writer = root;  // under MPI: rank 0 writes, every rank steps
+  const RunSummary sum = run(flow, run_opt);
+  const alefsi::Vec<6> Z = flow.body_velocity(0);
+  const Real U = scene.terminal_speed(), depth = -flow.body_centre(0)[2];
+  std::cout << std::setprecision(8) << "t = " << flow.time() << ": depth " << depth << " cm, velocity (" << Z[0]
+            << ", " << Z[1] << ", " << Z[2] << ") cm/s, spin |w| = " << std::setprecision(2) << Z.tail<3>().norm()
+            << "\n  -v_z / U_terminal = " << std::setprecision(6) << -Z[2] / U << " (U = " << U
+            << " cm/s: creeping flow, concentric spheres, K = " << scene.wall_factor() << ")\n"
+            << "  " << sum.steps << " steps, last solve " << flow.solver().iterations() << " iterations; wall "
+            << std::setprecision(3)
+            << std::chrono::duration<Real>(std::chrono::steady_clock::now() - wall0).count() << " s, CPU "
+            << cpu_seconds() - cpu0 << " s, peak " << std::setprecision(0) << std::fixed << peak_mb()
+            << " MB (this rank); files in " << o.output.string() << "\n";
+  return 0;
+} catch (const std::exception& e) {
+  std::cerr << "sphere_settling: " << e.what() << "\n";
+#ifdef ALEFSI_SETTLING_PETSC
+  if (PetscSession::size() > 1) MPI_Abort(PETSC_COMM_WORLD, 1);  // the other ranks may wait for this one
+#endif
+  return 1;
+}
+
+int main(int argc, char** argv) {
+#ifdef ALEFSI_SETTLING_PETSC
+  // outside settling_main's handler: PetscFinalize would wait for the other ranks before MPI_Abort
+  PetscSession petsc(argc, argv);
+#endif
+  return settling_main(argc, argv);
+}

@@ -19,7 +19,8 @@
 //                   pressure mass), mumps (PetscDirect). Under `mpirun -n P` pass only these:
 //                   every rank runs the others too. PETSc options after "--".
 //          --direct-max N   (default 16) largest N for the direct solvers
-//          --tol T   (default 1e-8) GMRES relative tolerance; --restart M (default 60)
+//          --tol T   (default 1e-8) GMRES relative tolerance; --restart M (default 60);
+//          --augment K (default 2: LGMRES corrections kept across restarts, 0: GMRES(M))
 //          --strength THETA, --sweeps S   AMG strength threshold (0.08) and Gauss–Seidel sweeps (1)
 //          --mass G  (default 0) add G * M_u (consistent velocity mass) to the velocity block
 //
@@ -50,6 +51,7 @@
 #include "alefsi/la/suitesparse.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
 #include "alefsi/physics/stokes.hpp"
+#include "../tests/support/stokes_systems.hpp"
 #ifdef ALEFSI_HAVE_PETSC
 #include "alefsi/la/petsc.hpp"
 #endif
@@ -80,65 +82,8 @@ void reset_peak_rss() {
   f << "5";
 }
 
-struct System {
-  SparseMatrix A;
-  VecX b;
-  SaddlePointBlocks blocks;
-};
-
-// consistent scalar velocity mass, added as gamma * M to every component of the free velocities
-template <class Pair>
-void add_velocity_mass(const MixedSpace<3, Pair>& space, const DofConstraints& cons, Real gamma, SparseMatrix& A) {
-  using V = typename Pair::template Velocity<3>;
-  const auto& rule = simplex_quadrature<3>(2 * V::degree);
-  Eigen::Matrix<Real, V::n_dofs, V::n_dofs> ref = Eigen::Matrix<Real, V::n_dofs, V::n_dofs>::Zero();
-  for (int q = 0; q < rule.size(); ++q) {
-    const auto phi = V::values(rule.points[q]);
-    for (int a = 0; a < V::n_dofs; ++a)
-      for (int c = 0; c < V::n_dofs; ++c) ref(a, c) += rule.weights[q] * phi[a] * phi[c];
-  }
-  const auto& mesh = space.mesh();
-  for (Index c = 0; c < mesh.n_cells(); ++c) {
-    const Real m = gamma * mesh.measure(c) / reference_measure<3>;
-    const auto& dofs = space.velocity().cell_dofs(c);
-    for (int k = 0; k < 3; ++k)
-      for (int a = 0; a < V::n_dofs; ++a) {
-        const Index fa = space.velocity_field(dofs[a], k);
-        if (cons.kind(fa) != DofConstraints::Kind::free) continue;
-        for (int e = 0; e < V::n_dofs; ++e) {
-          const Index fe = space.velocity_field(dofs[e], k);
-          if (cons.kind(fe) != DofConstraints::Kind::free) continue;
-          A.coeffRef(cons.indices(fa)[0], cons.indices(fe)[0]) += m * ref(a, e);  // in the pattern
-        }
-      }
-  }
-}
-
-template <class Pair>
-System cavity(int n, Real gamma) {
-  const Mesh<3> mesh = box_mesh(n, n, n);
-  MixedSpace<3, Pair> space(mesh);
-  StokesKernel<3, Pair> kernel(space, 1.0);
-  DofConstraints cons(space.n_field());
-  const auto& vel = space.velocity();
-  std::vector<char> done(vel.n_dofs(), 0);
-  for (int t : {tags::zmax, 1, 2, 3, 4, 5})
-    for (Index i : vel.boundary_dofs(t)) {
-      if (done[i]) continue;
-      done[i] = 1;
-      for (int k = 0; k < 3; ++k) cons.fix(space.velocity_field(i, k), (t == tags::zmax && k == 0) ? 1.0 : 0.0);
-    }
-  cons.fix(space.pressure_field(0), 0.0);
-  cons.finalize();
-  Assembler<MixedSpace<3, Pair>::n_local> asmb(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
-  System s;
-  VecX r;
-  asmb.assemble(kernel, cons.expand(VecX::Zero(cons.n_unknowns())), &s.A, &r);
-  s.b = -r;
-  if (gamma > 0) add_velocity_mass(space, cons, gamma, s.A);
-  s.blocks = saddle_point_blocks(space, cons, 1.0, gamma);
-  return s;
-}
+using System = alefsi::testing::SaddleSystem;
+using alefsi::testing::cavity3d;
 
 struct Options {
   std::vector<int> sizes{8, 16};
@@ -204,7 +149,7 @@ template <class Pair>
 void bench(const Options& o, const char* pair) {
   for (int n : o.sizes) {
     const double c0 = cpu_seconds();
-    const System s = cavity<Pair>(n, o.mass);
+    const System s = cavity3d<Pair>(n, o.mass);
     const double assemble = cpu_seconds() - c0;
     const double base = status_mb("VmRSS:");
     std::optional<VecX> direct;
@@ -323,6 +268,7 @@ int main(int argc, char** argv) {
     else if (a == "--direct-max") o.direct_max = std::stoi(next());
     else if (a == "--tol") o.krylov.tolerance = std::stod(next());
     else if (a == "--restart") o.krylov.restart = std::stoi(next());
+    else if (a == "--augment") o.krylov.augment = std::stoi(next());
     else if (a == "--strength") o.krylov.amg.strength = std::stod(next());
     else if (a == "--sweeps") o.krylov.amg.sweeps = std::stoi(next());
     else if (a == "--cycles") o.krylov.velocity_cycles = std::stoi(next());

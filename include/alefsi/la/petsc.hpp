@@ -172,12 +172,19 @@ class PetscSystem {
     return !mat_ || A.rows() != n_ || A.nonZeros() != nnz_ || detail::pattern_hash(A) != hash_;
   }
 
-  /// Copies A's values into the distributed matrix (a new pattern is analysed first) and sets
-  /// the KSP up: a numeric factorisation (MUMPS) or the preconditioner's set-up (BoomerAMG),
-  /// reusing the symbolic work of the same pattern.
-  void set_matrix(const SparseMatrix& A) {
+  /// Copies A's values into the distributed matrix, a new pattern being analysed first (then
+  /// it returns true: the caller's index sets follow the new rows). `setup` then factorises
+  /// (MUMPS) or sets the preconditioner up (BoomerAMG), reusing the symbolic work of the same
+  /// pattern.
+  bool set_matrix(const SparseMatrix& A) {
     ALEFSI_CHECK_ARG(A.isCompressed(), "A", "must be compressed (makeCompressed)");
-    if (new_pattern(A)) analyze(A);
+    const bool fresh = new_pattern(A);  // one pass over the indices per matrix
+    if (fresh) analyze(A);
+    set_values(A);
+    return fresh;
+  }
+  /// Copies the values of A, whose pattern is the one just analysed (no check).
+  void set_values(const SparseMatrix& A) {
     const Real* v = A.valuePtr();
     for (std::size_t e = 0; e < position_.size(); ++e) values_[e] = PetscScalar(v[position_[e]]);
     ALEFSI_PETSC(MatSetValuesCOO(mat_, values_.data(), INSERT_VALUES));
@@ -379,20 +386,18 @@ class PetscKrylov {
     analyzed_ = false;
     split_ = saddle_point_split(A, blocks_ ? &*blocks_ : nullptr, name);
     sys_.analyze(A);
-    // this rank's rows of split 0 (velocities [0, nu) and bodies [nu + np, n)) and of split 1
-    const Index p0 = split_.n_velocity, e0 = p0 + split_.n_pressure;
-    std::vector<PetscInt> rows0, rows1;
-    for (Index i = sys_.row_begin(); i < sys_.row_end(); ++i) (i >= p0 && i < e0 ? rows1 : rows0).push_back(PetscInt(i));
-    destroy_splits();
-    ALEFSI_PETSC(ISCreateGeneral(PETSC_COMM_WORLD, PetscInt(rows0.size()), rows0.data(), PETSC_COPY_VALUES, &is0_));
-    ALEFSI_PETSC(ISCreateGeneral(PETSC_COMM_WORLD, PetscInt(rows1.size()), rows1.data(), PETSC_COPY_VALUES, &is1_));
-    analyzed_ = true;
-    configured_ = false;
+    make_splits();
   }
 
   void factorize(const SparseMatrix& A) {
-    if (!analyzed_ || sys_.new_pattern(A)) analyze(A);
-    sys_.set_matrix(A);
+    if (!analyzed_) {
+      analyze(A);
+      sys_.set_values(A);
+    } else if (sys_.set_matrix(A)) {  // a new pattern (e.g. after a remesh): new splits
+      analyzed_ = false;
+      split_ = saddle_point_split(A, blocks_ ? &*blocks_ : nullptr, name);
+      make_splits();
+    }
     if (sys_.take_first()) configured_ = false;
     try {
       if (!configured_) configure(A);
@@ -415,6 +420,20 @@ class PetscKrylov {
   KSP ksp() const { return sys_.ksp(); }
 
  private:
+  // The splits' index sets: this rank's rows of split 0 (velocities [0, nu) and bodies
+  // [nu + np, n)) and of split 1 (pressures)
+  void make_splits() {
+    const Index p0 = split_.n_velocity, e0 = p0 + split_.n_pressure;
+    std::vector<PetscInt> rows0, rows1;
+    for (Index i = sys_.row_begin(); i < sys_.row_end(); ++i) (i >= p0 && i < e0 ? rows1 : rows0).push_back(PetscInt(i));
+    destroy_splits();
+    ALEFSI_PETSC(ISCreateGeneral(PETSC_COMM_WORLD, PetscInt(rows0.size()), rows0.data(), PETSC_COPY_VALUES, &is0_));
+    ALEFSI_PETSC(ISCreateGeneral(PETSC_COMM_WORLD, PetscInt(rows1.size()), rows1.data(), PETSC_COPY_VALUES, &is1_));
+    analyzed_ = true;
+    configured_ = false;
+  }
+
+
   // The KSP's type, splits and defaults, then the options database.
   void configure(const SparseMatrix& A) {
     KSP ksp = sys_.ksp();

@@ -17,6 +17,7 @@
 #include "alefsi/fem/dofmap.hpp"
 #include "alefsi/la/amg.hpp"
 #include "alefsi/la/assembler.hpp"
+#include "alefsi/la/gmres.hpp"
 #include "alefsi/la/krylov.hpp"
 #include "alefsi/la/ordering.hpp"
 #include "alefsi/la/solvers.hpp"
@@ -463,6 +464,49 @@ TEST_CASE("AleFlow with SaddlePointGmres: a 3D Navier–Stokes step with a free 
   const VecX& u1 = krylov.field();
   CHECK((u1 - u0).norm() <= 1e-7 * u0.norm());
   CHECK((krylov.body_velocity(0) - direct.body_velocity(0)).norm() <= 1e-7 * direct.body_velocity(0).norm());
+}
+
+TEST_CASE("gmres with augment (LGMRES): the corrections keep what a short restart loses; the answer is the "
+          "direct one",
+          "[la][krylov][quick]") {
+  // 1D convection–diffusion, -u'' + 20 u' on 400 cells (upwind), Jacobi-preconditioned: a
+  // nonsymmetric matrix on which GMRES(10) needs many cycles
+  const Index n = 400;
+  const Real h = 1.0 / Real(n + 1), c = 20;
+  std::vector<Eigen::Triplet<Real>> t;
+  for (Index i = 0; i < n; ++i) {
+    t.emplace_back(i, i, 2 / (h * h) + c / h);
+    if (i > 0) t.emplace_back(i, i - 1, -1 / (h * h) - c / h);
+    if (i + 1 < n) t.emplace_back(i, i + 1, -1 / (h * h));
+  }
+  SparseMatrix A(n, n);
+  A.setFromTriplets(t.begin(), t.end());
+  const VecX b = VecX::Ones(n), inv_diag = A.diagonal().cwiseInverse();
+  auto jacobi = [&](const VecX& v) { return VecX(inv_diag.cwiseProduct(v)); };
+  Eigen::SparseLU<SparseMatrix> lu(A);
+  const VecX x_direct = lu.solve(b);
+  auto solve = [&](int augment) {
+    VecX x;
+    GmresWork work;
+    const GmresResult res =
+        gmres(A, b, jacobi, {.tolerance = 1e-10, .max_iterations = 5000, .restart = 10, .augment = augment}, x, work);
+    CHECK(res.converged);
+    CHECK((b - A * x).norm() <= 1e-10 * b.norm());
+    CHECK(res.residual <= 1e-10);
+    CHECK((x - x_direct).norm() <= 1e-6 * x_direct.norm());
+    return res.iterations;
+  };
+  const int plain = solve(0), one = solve(1), two = solve(2);
+  INFO("GMRES(10) " << plain << ", LGMRES(10,1) " << one << ", LGMRES(10,2) " << two << " iterations");
+  CHECK(two < plain);
+  CHECK(one < plain);
+  // a system solved within the first cycle: the corrections never enter, the iterate is GMRES's
+  VecX x0, x1;
+  GmresWork w0, w1;
+  const GmresResult r0 = gmres(A, b, jacobi, {.tolerance = 1e-6, .restart = 1000}, x0, w0);
+  const GmresResult r1 = gmres(A, b, jacobi, {.tolerance = 1e-6, .restart = 1000, .augment = 2}, x1, w1);
+  CHECK(r0.iterations == r1.iterations);
+  CHECK(x0 == x1);
 }
 
 TEST_CASE("SaddlePointGmres on a graded mesh with a free sphere: LGMRES converges where GMRES(60) stagnates, and "

@@ -16,6 +16,7 @@
 #include "alefsi/fem/constraints.hpp"
 #include "alefsi/fem/dofmap.hpp"
 #include "alefsi/la/assembler.hpp"
+#include "alefsi/la/partition.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
 #include "alefsi/physics/navier_stokes.hpp"
 #include "alefsi/physics/stokes.hpp"
@@ -896,4 +897,82 @@ TEST_CASE("detail::UninitArray: sizes, kept contents, storage reuse, on the heap
     a.clear();
     CHECK(a.empty());
   }
+}
+
+TEST_CASE("cells in Morton parts: balanced, a cube cut on its mid-plane, and the parts' assemblies sum to the whole",
+          "[la][assembly][partition][quick]") {
+  // a structured cube in two parts is cut on x = 1/2 (the Morton key's leading bit): the parts
+  // share exactly the (n+1)^2 nodes of that plane
+  const int n = 4;
+  const Mesh<3> cube = box_mesh(n, n, n);
+  const std::vector<int> halves = partition_cells(cube, 2);
+  std::vector<int> seen(std::size_t(cube.n_nodes()), 0);
+  for (Index c = 0; c < cube.n_cells(); ++c)
+    for (Index v : cube.cell(c)) seen[std::size_t(v)] |= 1 << halves[std::size_t(c)];
+  int shared = 0;
+  for (Index v = 0; v < cube.n_nodes(); ++v)
+    if (seen[std::size_t(v)] == 3) {
+      ++shared;
+      CHECK(cube.node(v)[0] == Approx(0.5));
+    }
+  CHECK(shared == (n + 1) * (n + 1));
+  // balance: part sizes differ by at most one cell, and every cell has a part
+  for (int parts : {1, 3, 7}) {
+    const std::vector<int> part = partition_cells(cube, parts);
+    std::vector<Index> size(std::size_t(parts), 0);
+    for (int p : part) ++size[std::size_t(p)];
+    CHECK(*std::max_element(size.begin(), size.end()) - *std::min_element(size.begin(), size.end()) <= 1);
+    CHECK(std::accumulate(size.begin(), size.end(), Index(0)) == cube.n_cells());
+  }
+  CHECK_THROWS_AS(partition_cells(cube, 0), InvalidArgument);
+
+  // the annulus with a fixed component and a 6-unknown link (the test above): three parts'
+  // Jacobians and residuals sum to the whole assembly; unknowns a part does not touch have
+  // empty rows and columns there (refused when an assembler covers all cells)
+  const auto mesh = annulus_mesh(0.3, 1.0, 4, 20);
+  using Space = MixedSpace<2, TaylorHood>;
+  Space space(mesh);
+  DofConstraints cons(space.n_field());
+  const Index z = cons.add_unknowns(6);
+  for (Index i : space.velocity().boundary_dofs(tags::outer)) cons.fix(space.velocity_field(i, 0), 0.3);
+  for (Index i : space.velocity().boundary_dofs(tags::inner)) {
+    const Vec<2> x = space.velocity().point(i);
+    const Index ex[] = {z, z + 1, z + 2, z + 3, z + 4, z + 5};
+    const Real w0[] = {1.0, 0.0, -x[1], x[0] * x[0], 0.5, -x[0] * x[1]};
+    const Real w1[] = {0.0, 1.0, x[0], 0.2, x[1] * x[1], x[0]};
+    cons.link(space.velocity_field(i, 0), ex, w0, 0.01);
+    cons.link(space.velocity_field(i, 1), ex, w1, -0.02);
+  }
+  cons.finalize();
+  VecX field(space.n_field());
+  for (Index f = 0; f < field.size(); ++f) field[f] = std::sin(1.3 * f);
+  PseudoRandomKernel<Space::n_local> k;
+  Assembler<Space::n_local> whole(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
+  SparseMatrix J;
+  VecX r;
+  whole.assemble(k, field, &J, &r);
+  const std::vector<int> part = partition_cells(mesh, 3);
+  SparseMatrix sum(J.rows(), J.cols());
+  VecX rsum = VecX::Zero(r.size());
+  Index nnz = 0;
+  for (int p = 0; p < 3; ++p) {
+    const std::vector<Index> cells = cells_of_part(part, p);
+    Assembler<Space::n_local> mine(
+        Index(cells.size()), [&](Index i) { return space.cell_field_dofs(cells[std::size_t(i)]); }, cons,
+        AssembledCells::part);
+    SparseMatrix Jp;
+    VecX rp;
+    mine.assemble(PartKernel<PseudoRandomKernel<Space::n_local>>{&k, &cells}, field, &Jp, &rp);
+    CHECK(Jp.rows() == J.rows());
+    CHECK(Jp.nonZeros() < J.nonZeros());
+    nnz += Jp.nonZeros();
+    sum += Jp, rsum += rp;
+  }
+  CHECK(nnz > J.nonZeros());  // the parts overlap on their interface
+  CHECK((MatX(sum) - MatX(J)).norm() <= 1e-13 * MatX(J).norm());
+  CHECK((rsum - r).norm() <= 1e-13 * r.norm());
+  const std::vector<Index> first = cells_of_part(part, 0);
+  CHECK_THROWS_AS(Assembler<Space::n_local>(
+                      Index(first.size()), [&](Index i) { return space.cell_field_dofs(first[std::size_t(i)]); }, cons),
+                  SolverError);
 }

@@ -56,6 +56,11 @@
 ///     asmb.set_threads(2);                    // optional
 ///     asmb.assemble(kernel, field, &J, &r);   // J: asmb.matrix() shape, r: n_unknowns
 ///     asmb.rebuild(mesh.n_cells(), ..., cons); asmb.take_pattern(J);  // after a remesh
+///
+/// Cells of one part (`AssembledCells::part`: a process's cells under MPI, la/partition.hpp):
+/// the n cells given are some of the mesh's, `cell_dofs(i)` and the kernel's `cell(i, ...)`
+/// number them 0 .. n - 1, and an unknown that none of them touches has an empty column and row
+/// (with all cells, such an unknown is an error: the system would be singular).
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -240,6 +245,9 @@ concept CellKernel = requires(const K& k, Index c, const Eigen::Matrix<Real, N, 
   k.cell(c, u, A, r);
 };
 
+/// Whether an Assembler covers all the mesh's cells or one part of them (file comment).
+enum class AssembledCells { all, part };
+
 template <int N>
 class Assembler {
  public:
@@ -253,7 +261,9 @@ class Assembler {
 
   /// `cell_dofs(c)` returns cell c's N field DOFs; `cons` must be finalized.
   template <class CellDofsFn>
-  Assembler(Index n_cells, CellDofsFn&& cell_dofs, const DofConstraints& cons) : cons_(&cons) {
+  Assembler(Index n_cells, CellDofsFn&& cell_dofs, const DofConstraints& cons,
+            AssembledCells cells = AssembledCells::all)
+      : cons_(&cons), cells_(cells) {
     if (!cons.finalized()) throw Error("Assembler: DofConstraints must be finalized first");
     build(n_cells, cell_dofs);
   }
@@ -265,9 +275,11 @@ class Assembler {
   /// take the new one (`take_pattern`: it reuses the matrix's storage too). If it throws,
   /// the assembler may only be rebuilt or destroyed.
   template <class CellDofsFn>
-  void rebuild(Index n_cells, CellDofsFn&& cell_dofs, const DofConstraints& cons) {
+  void rebuild(Index n_cells, CellDofsFn&& cell_dofs, const DofConstraints& cons,
+               AssembledCells cells = AssembledCells::all) {
     if (!cons.finalized()) throw Error("Assembler: DofConstraints must be finalized first");
     cons_ = &cons;
+    cells_ = cells;
     matrix_built_ = false;
     build(n_cells, cell_dofs);
   }
@@ -637,8 +649,9 @@ class Assembler {
   void build_groups(Scratch& s) {
     const Index n = n_unknowns(), nc = n_cells();
     const Index* cnt = outer_.data();
-    for (Index u = 0; u < n; ++u)
-      if (cnt[u] == 0) throw SolverError("unknown " + std::to_string(u) + " is coupled to nothing");
+    if (cells_ == AssembledCells::all)
+      for (Index u = 0; u < n; ++u)
+        if (cnt[u] == 0) throw SolverError("unknown " + std::to_string(u) + " is coupled to nothing");
     // gid (+ 4: the branch-free rank writes of build_pattern) first holds "same as u - 1"
     Index* gid = s.gid.resize_for_overwrite(std::size_t(n) + 4);
     if (n > 0) gid[0] = 0;
@@ -882,6 +895,8 @@ class Assembler {
     };
     for (std::size_t b = 0; b < blk_.size(); ++b)
       if (gs[bg[b]].len < 0) visit(bg[b]);
+    for (Index g = 0; g < ng; ++g)  // a group no cell touches (AssembledCells::part): empty columns
+      if (gs[g].len < 0) gs[g].len = 0, gadj_at[g] = a;
     gadj_at[ng] = a;
     gadj_.resize_keep(std::size_t(a));
     // column starts (in unknown order), then each block's column start and length
@@ -990,6 +1005,7 @@ class Assembler {
   detail::UninitArray<Index> chunk_cells_;
   std::vector<Index> chunk_start_, chunk_order_, colour_start_;
   int threads_ = 1;
+  AssembledCells cells_ = AssembledCells::all;
   detail::UninitArray<Index> outer_;  // CSC pattern: column starts
   // the rows by groups: group g = unknowns gfirst_[g] .. gfirst_[g + 1] - 1; its columns' rows
   // are the groups at gadj_[gadj_at_[g]], ascending, as many as make up the column length

@@ -120,6 +120,68 @@ TEST_CASE("PetscDirect (MUMPS) and PetscKrylov solve 3D Stokes (P2/P1, P1/P1-GLS
   }
 }
 
+TEST_CASE("assembled in parts: each rank passes the matrix of its cells, and MUMPS and GMRES solve with their sum",
+          "[petsc][cavity][parts][quick]") {
+  // the cavity's cells in Morton parts, one per rank (la/partition.hpp); PETSc sums the parts
+  // (COO entries of other ranks' rows are sent) and the rows belong to the lowest rank touching them
+  const int parts = PetscSession::size(), me = PetscSession::rank();
+  for (int pair = 0; pair < 2; ++pair) {
+    CAPTURE(pair);
+    const auto s = pair == 0 ? cavity3d<TaylorHood>(6, 0, parts, me) : cavity3d<P1P1Gls>(8, 0, parts, me);
+    const SparseMatrix& mine = parts > 1 ? s.part : s.A;
+    if (parts > 1) CHECK(mine.nonZeros() < s.A.nonZeros());
+    const VecX reference = serial_solve(s.A, s.b);
+    PetscDirect lu;
+    lu.set_summed(true);
+    lu.factorize(mine);
+    const VecX x = lu.solve(s.b);
+    CHECK((x - reference).norm() <= 1e-10 * reference.norm());
+    check_ownership(lu, s.A.rows());
+    // the Schur complement by the pressure mass (steady Stokes: mass coefficient 0) and by
+    // PETSc's selfp (the time-step path, chosen by a positive coefficient)
+    for (Real coefficient : {0.0, 1.0}) {
+      CAPTURE(coefficient);
+      SaddlePointBlocks blocks = s.blocks;
+      blocks.mass_coefficient = coefficient;
+      PetscKrylov<3> k({.tolerance = 1e-11});
+      k.set_summed(true);
+      k.set_blocks(blocks);
+      k.factorize(mine);
+      CHECK(k.pressure_mass() == (coefficient == 0));
+      const VecX y = k.solve(s.b);
+      CHECK(relative_residual(s.A, y, s.b) <= 1.1e-11);
+      CHECK((y - reference).norm() <= 1e-6 * reference.norm());
+      check_ownership(k, s.A.rows());
+    }
+  }
+}
+
+TEST_CASE("MatPartitioning (PT-Scotch) gives every rank the same balanced parts of the cells",
+          "[petsc][parts][quick]") {
+  // the flow's partition of the cells under MPI (sim/discretisation.hpp); PT-Scotch's load
+  // imbalance target is 1 % (-mat_partitioning_ptscotch_imbalance 0.01)
+  const Mesh<3> mesh = read_gmsh<3>(std::string(ALEFSI_TEST_DATA_DIR) + "/gmsh/sphere_in_box3d.msh").mesh;
+  const int parts = PetscSession::size();
+  const std::vector<int> part = PetscKrylov<3>().partition(mesh);
+  REQUIRE(part.size() == std::size_t(mesh.n_cells()));
+  std::vector<int> low = part, high = part, minus = part;
+  for (int& p : minus) p = -p;
+  high = minus;
+  PetscDirect().min(low), PetscDirect().min(high);  // the same array on every rank: min = max
+  CHECK(low == part);
+  CHECK(high == minus);
+  std::vector<Index> size(std::size_t(parts), 0);
+  for (int p : part) {
+    REQUIRE((p >= 0 && p < parts));
+    ++size[std::size_t(p)];
+  }
+  const Real mean = Real(mesh.n_cells()) / parts;
+  CHECK(*std::max_element(size.begin(), size.end()) <= 1.01 * mean + 1);
+  std::cout << "PT-Scotch parts of " << mesh.n_cells() << " cells:";
+  for (Index n : size) std::cout << " " << n;
+  std::cout << "\n";
+}
+
 TEST_CASE("PetscKrylov: bad input and a solve that cannot converge are typed errors", "[petsc][quick]") {
   CHECK_THROWS_AS(PetscKrylov<3>({.tolerance = 0}), InvalidArgument);
   CHECK_THROWS_AS(PetscKrylov<3>({.restart = 0}), InvalidArgument);
@@ -204,6 +266,14 @@ TEST_CASE("AleFlow with PetscKrylov<3> or PetscDirect: 3D Navier–Stokes steps 
   CHECK((krylov.body_velocity(0) - serial.body_velocity(0)).norm() <= 1e-7 * serial.body_velocity(0).norm());
   CHECK((direct.field() - u0).norm() <= 1e-10 * u0.norm());
   CHECK((direct.body_velocity(0) - serial.body_velocity(0)).norm() <= 1e-10 * serial.body_velocity(0).norm());
+  // on several ranks each assembles the cells of its part (la/partition.hpp): the parts cover
+  // the mesh once
+  for (Index mine : {krylov.assembled_cells(), direct.assembled_cells()}) {
+    Index total = 0;
+    MPI_Allreduce(&mine, &total, 1, MPI_INT, MPI_SUM, PETSC_COMM_WORLD);
+    CHECK(total == mesh.n_cells());
+    if (PetscSession::size() > 1) CHECK(mine < mesh.n_cells());
+  }
 }
 
 TEST_CASE("a sphere settling in a spherical container: 10 steps through run() on N ranks follow the serial "

@@ -10,6 +10,7 @@
 #include "alefsi/fem/constraints.hpp"
 #include "alefsi/fem/dofmap.hpp"
 #include "alefsi/la/assembler.hpp"
+#include "alefsi/la/partition.hpp"
 #include "alefsi/la/saddle_point_blocks.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
 #include "alefsi/physics/stokes.hpp"
@@ -20,6 +21,7 @@ struct SaddleSystem {
   SparseMatrix A;
   VecX b;
   SaddlePointBlocks blocks;
+  SparseMatrix part;  // with parts > 1: the matrix of part `part`'s cells (la/partition.hpp)
 };
 
 // consistent scalar velocity mass, added as gamma * M to every component of the free velocities
@@ -53,8 +55,9 @@ inline void add_velocity_mass(const MixedSpace<3, Pair>& space, const DofConstra
 // 3D lid-driven cavity on box_mesh(n, n, n): every boundary velocity fixed (lid z = 1:
 // (1, 0, 0)), pressure DOF 0 pinned, mu = 1; b = -r at the zero field. gamma > 0 adds gamma M_u
 // to the velocity block (the rho a0 / dt part of a time step) and hands it to the blocks.
+// parts > 1 (gamma 0): also the matrix of the cells of Morton part `part` of `parts`.
 template <class Pair>
-inline SaddleSystem cavity3d(int n, Real gamma = 0) {
+inline SaddleSystem cavity3d(int n, Real gamma = 0, int parts = 1, int part = 0) {
   const Mesh<3> mesh = box_mesh(n, n, n);
   MixedSpace<3, Pair> space(mesh);
   StokesKernel<3, Pair> kernel(space, 1.0);
@@ -76,6 +79,14 @@ inline SaddleSystem cavity3d(int n, Real gamma = 0) {
   s.b = -r;
   if (gamma > 0) add_velocity_mass(space, cons, gamma, s.A);
   s.blocks = saddle_point_blocks(space, cons, 1.0, gamma);
+  if (parts > 1) {
+    const std::vector<Index> cells = cells_of_part(partition_cells(mesh, parts), part);
+    Assembler<MixedSpace<3, Pair>::n_local> mine(
+        Index(cells.size()), [&](Index i) { return space.cell_field_dofs(cells[std::size_t(i)]); }, cons,
+        AssembledCells::part);
+    mine.assemble(PartKernel<StokesKernel<3, Pair>>{&kernel, &cells}, cons.expand(VecX::Zero(cons.n_unknowns())),
+                  &s.part, nullptr);
+  }
   return s;
 }
 

@@ -3,14 +3,21 @@
 /// PETSc linear-solver policies, for runs under `mpirun` (optional: link the CMake target
 /// `alefsi::petsc`, defined when pkg-config finds PETSc at configure time; Debian: petsc-dev).
 ///
-/// The model is a shared mesh: every rank holds the whole mesh and runs the whole program on it
-/// (assembly with the library's kernels included), and the linear solves are distributed. Each
-/// rank owns a contiguous range of rows of a PETSc AIJ matrix (MPIAIJ on several ranks) and sets
-/// its rows' values from the assembled matrix through PETSc's COO interface: the positions are
-/// found once per sparsity pattern (`analyze`), and each new matrix is a copy of values
-/// (`factorize`), with no per-entry search. `solve(b)` gathers the solution to every rank, so the
-/// rest of the program (Newton updates, bodies, output) runs on the same numbers everywhere.
-/// What this model costs per rank and where it stops: docs/performance.md, "PETSc and MPI".
+/// The model is a shared mesh: every rank holds the whole mesh and runs the whole program on it,
+/// and the matrix and its solves are distributed. A flow (sim/discretisation.hpp) on several
+/// ranks assembles in parts: each rank the Jacobian of its own cells (a Morton part,
+/// la/partition.hpp) with the library's kernels, into the pattern of those cells, and the
+/// residual is summed over the ranks (`set_summed(true)`). The rows of PETSc's AIJ matrix
+/// (MPIAIJ on several ranks) belong to the lowest rank whose cells touch them and are numbered
+/// rank after rank; each rank hands its part's entries to PETSc's COO interface, which sums the
+/// parts (sending the entries of other ranks' rows: the interface). A matrix passed whole (the
+/// default, e.g. a system assembled by the caller on every rank) is split into contiguous
+/// ranges of rows instead, each rank setting its own. Either way the positions are found once
+/// per sparsity pattern (`analyze`), and each new matrix is a copy of values (`factorize`),
+/// with no per-entry search. `solve(b)` takes the whole right-hand side and gathers the solution
+/// to every rank, so the rest of the program (Newton updates, bodies, output) runs on the same
+/// numbers everywhere. What this model costs per rank and where it stops: docs/performance.md,
+/// "PETSc and MPI".
 ///
 ///   PetscDirect      MUMPS LU (KSPPREONLY + PCLU); `direct = true`, so the flow's factorisation
 ///                    reuse (la/linear_solve.hpp) works with it.
@@ -21,7 +28,7 @@
 ///                    unknowns, pressures): hypre BoomerAMG on split 0 (velocities and bodies), and
 ///                    for the Schur complement either the pressure mass matrix, -(M_p / mu + C),
 ///                    with SSOR (steady Stokes: blocks given by `set_blocks` with
-///                    mass_coefficient 0, as an AleFlow with rho = 0 hands them over) or PETSc's
+///                    mass_coefficient 0, as saddle_point_blocks(space, cons, mu, 0) makes them) or PETSc's
 ///                    -(B diag(A)^-1 B^T + C) ("selfp", the time-step regime where rho/dt
 ///                    dominates) with BoomerAMG.
 ///
@@ -53,8 +60,11 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <type_traits>
 #include <cstdio>
+#include <exception>
+#include <iostream>
 #include <set>
 #include <optional>
 #include <string>
@@ -64,6 +74,8 @@
 #include "alefsi/core/eigen_sparse.hpp"
 #include "alefsi/core/error.hpp"
 #include "alefsi/la/assembler.hpp"
+#include "alefsi/la/partition.hpp"
+#include "alefsi/mesh/mesh.hpp"
 #include "alefsi/la/saddle_point_blocks.hpp"
 #include "alefsi/la/solvers.hpp"
 
@@ -132,7 +144,108 @@ class PetscSession {
   bool owner_ = false;
 };
 
+/// The `main` of a program run under mpirun (examples/sphere_settling.cpp): a PetscSession
+/// around `body(argc, argv)`, with argv cut at "--" (what follows is PETSc's options, already in
+/// its database) and std::cout silent on ranks other than 0 (rank 0 prints). An exception from
+/// `body` is printed (std::cerr) and makes the status 1; a non-zero status on several ranks ends
+/// them all (MPI_Abort: the others may be waiting for this one in a collective call), before
+/// the session's PetscFinalize, which would wait for them.
+///
+///     int main(int argc, char** argv) { return alefsi::petsc_main(argc, argv, program_main); }
+template <class Body>
+int petsc_main(int argc, char** argv, Body&& body) {
+  PetscSession session(argc, argv);
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--") {
+      argc = i;
+      break;
+    }
+  std::streambuf* const out = std::cout.rdbuf();
+  if (PetscSession::rank() != 0) std::cout.rdbuf(nullptr);
+  int status = 1;
+  try {
+    status = body(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << (argc > 0 ? argv[0] : "alefsi") << ": " << e.what() << "\n";
+  }
+  std::cout.rdbuf(out);
+  if (status != 0 && PetscSession::size() > 1) MPI_Abort(PETSC_COMM_WORLD, status);
+  return status;
+}
+
 namespace detail {
+
+/// The part (rank) of each cell of `mesh` by PETSc's MatPartitioning on the cells' dual graph
+/// (two cells adjacent when they share a facet): PT-Scotch or ParMETIS, whichever PETSc has
+/// (`-mat_partitioning_type` chooses another), each rank passing a contiguous range of the
+/// graph's rows; the parts are gathered, so every rank gets the whole array. Empty when PETSc has
+/// neither partitioner (the caller then cuts along the Morton curve, la/partition.hpp); all 0 on
+/// one rank.
+template <int D>
+std::vector<int> petsc_partition(const Mesh<D>& mesh) {
+  const Index nc = mesh.n_cells();
+  if (PetscSession::size() == 1) return std::vector<int>(std::size_t(nc), 0);
+#if defined(PETSC_HAVE_PTSCOTCH) || defined(PETSC_HAVE_PARMETIS)
+  PetscInt local = PETSC_DECIDE, global = PetscInt(nc), end = 0;
+  ALEFSI_PETSC(PetscSplitOwnership(PETSC_COMM_WORLD, &local, &global));
+  if (MPI_Scan(&local, &end, 1, MPIU_INT, MPI_SUM, PETSC_COMM_WORLD) != MPI_SUCCESS)
+    throw PetscError("PETSc: MPI_Scan of the cell ranges failed");
+  const Index c0 = Index(end - local), c1 = Index(end);
+  std::vector<PetscInt> nbr;
+  std::vector<PetscInt> start{0};
+  for (Index c = c0; c < c1; ++c) {
+    for (Index f : mesh.cell_facets(c)) {
+      const auto& fc = mesh.facet_cells(f);
+      const Index other = fc[0] == c ? fc[1] : fc[0];
+      if (other >= 0) nbr.push_back(PetscInt(other));
+    }
+    start.push_back(PetscInt(nbr.size()));
+  }
+  // MatCreateMPIAdj takes arrays from PetscMalloc and frees them with the matrix
+  PetscInt *ia = nullptr, *ja = nullptr;
+  ALEFSI_PETSC(PetscMalloc1(start.size(), &ia));
+  ALEFSI_PETSC(PetscMalloc1(std::max<std::size_t>(nbr.size(), 1), &ja));
+  std::copy(start.begin(), start.end(), ia);
+  std::copy(nbr.begin(), nbr.end(), ja);
+  ::Mat adj = nullptr;
+  MatPartitioning mp = nullptr;
+  IS is = nullptr, all = nullptr;
+  auto release = [&] {
+    if (all) ISDestroy(&all);
+    if (is) ISDestroy(&is);
+    if (mp) MatPartitioningDestroy(&mp);
+    if (adj) MatDestroy(&adj);
+  };
+  std::vector<int> part(static_cast<std::size_t>(nc));
+  try {
+    ALEFSI_PETSC(MatCreateMPIAdj(PETSC_COMM_WORLD, local, global, ia, ja, nullptr, &adj));
+    ALEFSI_PETSC(MatPartitioningCreate(PETSC_COMM_WORLD, &mp));
+    ALEFSI_PETSC(MatPartitioningSetAdjacency(mp, adj));
+    ALEFSI_PETSC(MatPartitioningSetNParts(mp, PetscSession::size()));
+#ifdef PETSC_HAVE_PTSCOTCH
+    ALEFSI_PETSC(MatPartitioningSetType(mp, MATPARTITIONINGPTSCOTCH));
+#else
+    ALEFSI_PETSC(MatPartitioningSetType(mp, MATPARTITIONINGPARMETIS));
+#endif
+    ALEFSI_PETSC(MatPartitioningSetFromOptions(mp));
+    ALEFSI_PETSC(MatPartitioningApply(mp, &is));
+    ALEFSI_PETSC(ISAllGather(is, &all));
+    const PetscInt* p = nullptr;
+    ALEFSI_PETSC(ISGetIndices(all, &p));
+    for (Index c = 0; c < nc; ++c) part[std::size_t(c)] = int(p[c]);
+    ALEFSI_PETSC(ISRestoreIndices(all, &p));
+  } catch (...) {
+    if (!adj) PetscFree(ia), PetscFree(ja);
+    release();
+    throw;
+  }
+  release();
+  return part;
+#else
+  (void)mesh;
+  return {};
+#endif
+}
 
 /// The distributed copy of a matrix assembled on every rank, its KSP, and the vectors of a
 /// solve: what PetscDirect and PetscKrylov share.
@@ -167,9 +280,43 @@ class PetscSystem {
     }
   }
 
-  /// Whether `A` has another pattern than the one analysed (or none was).
+  /// Whether `A` has another pattern than the one analysed (or none was); with summed parts,
+  /// whether any rank's part has a new pattern (so that all analyse together).
   bool new_pattern(const SparseMatrix& A) const {
-    return !mat_ || A.rows() != n_ || A.nonZeros() != nnz_ || detail::pattern_hash(A) != hash_;
+    int fresh = !mat_ || A.rows() != n_ || A.nonZeros() != nnz_ || detail::pattern_hash(A) != hash_;
+    if (summed_ && MPI_Allreduce(MPI_IN_PLACE, &fresh, 1, MPI_INT, MPI_MAX, PETSC_COMM_WORLD) != MPI_SUCCESS)
+      throw PetscError("PETSc: MPI_Allreduce of the pattern flags failed");
+    return fresh != 0;
+  }
+
+  /// With `summed` (and more than one rank), the matrix each rank passes is its part (the
+  /// entries of its cells: la/partition.hpp) and the distributed matrix is the sum of the parts.
+  /// A row belongs to the lowest rank whose part has entries in it; PETSc numbers each rank's
+  /// rows after the lower ranks' (in the library's order within a rank), so that a rank owns the
+  /// rows of its cells and sends only its interface entries. Takes effect at the next analysis.
+  void set_summed(bool summed) {
+    summed = summed && PetscSession::size() > 1;
+    if (summed == summed_) return;
+    summed_ = summed;
+    destroy_pattern();
+  }
+  bool summed() const { return summed_; }
+  /// Sums `v` over the ranks, each rank getting the same bits (reduced on rank 0, broadcast).
+  static void sum(VecX& v) {
+    if (PetscSession::size() == 1) return;
+    const int n = int(v.size());
+    VecX total = PetscSession::rank() == 0 ? VecX(n) : VecX();
+    if (MPI_Reduce(v.data(), PetscSession::rank() == 0 ? total.data() : nullptr, n, MPI_DOUBLE, MPI_SUM, 0,
+                   PETSC_COMM_WORLD) != MPI_SUCCESS)
+      throw PetscError("PETSc: MPI_Reduce of a summed vector failed");
+    if (PetscSession::rank() == 0) v = std::move(total);
+    if (MPI_Bcast(v.data(), n, MPI_DOUBLE, 0, PETSC_COMM_WORLD) != MPI_SUCCESS)
+      throw PetscError("PETSc: MPI_Bcast of a summed vector failed");
+  }
+  /// The elementwise minimum of `w` over the ranks.
+  static void min(std::vector<int>& w) {
+    if (MPI_Allreduce(MPI_IN_PLACE, w.data(), int(w.size()), MPI_INT, MPI_MIN, PETSC_COMM_WORLD) != MPI_SUCCESS)
+      throw PetscError("PETSc: MPI_Allreduce of a minimum failed");
   }
 
   /// Copies A's values into the distributed matrix, a new pattern being analysed first (then
@@ -198,19 +345,49 @@ class PetscSystem {
     nnz_ = A.nonZeros();
     hash_ = detail::pattern_hash(A);
     PetscInt local = PETSC_DECIDE, global = PetscInt(n_);
-    ALEFSI_PETSC(PetscSplitOwnership(PETSC_COMM_WORLD, &local, &global));
-    PetscInt end = 0;
-    if (MPI_Scan(&local, &end, 1, MPIU_INT, MPI_SUM, PETSC_COMM_WORLD) != MPI_SUCCESS)
-      throw PetscError("PETSc: MPI_Scan of the row ranges failed");
-    row_begin_ = Index(end - local), row_end_ = Index(end);
     std::vector<PetscInt> ci, cj;
     position_.clear();
-    for (Index j = 0; j < n_; ++j)
-      for (Index k = A.outerIndexPtr()[j]; k < A.outerIndexPtr()[j + 1]; ++k) {
-        const Index i = A.innerIndexPtr()[k];
-        if (i < row_begin_ || i >= row_end_) continue;
-        ci.push_back(PetscInt(i)), cj.push_back(PetscInt(j)), position_.push_back(k);
+    owned_.clear();
+    if (!summed_) {  // contiguous ranges of the library's numbering; each rank sets its rows
+      perm_.clear();
+      ALEFSI_PETSC(PetscSplitOwnership(PETSC_COMM_WORLD, &local, &global));
+      PetscInt end = 0;
+      if (MPI_Scan(&local, &end, 1, MPIU_INT, MPI_SUM, PETSC_COMM_WORLD) != MPI_SUCCESS)
+        throw PetscError("PETSc: MPI_Scan of the row ranges failed");
+      row_begin_ = Index(end - local), row_end_ = Index(end);
+      for (Index i = row_begin_; i < row_end_; ++i) owned_.push_back(i);
+      for (Index j = 0; j < n_; ++j)
+        for (Index k = A.outerIndexPtr()[j]; k < A.outerIndexPtr()[j + 1]; ++k) {
+          const Index i = A.innerIndexPtr()[k];
+          if (i < row_begin_ || i >= row_end_) continue;
+          ci.push_back(PetscInt(i)), cj.push_back(PetscInt(j)), position_.push_back(k);
+        }
+    } else {  // parts: rows owned by the lowest rank that has entries in them (set_summed)
+      const int rank = PetscSession::rank(), size = PetscSession::size();
+      std::vector<int> owner(std::size_t(n_), std::numeric_limits<int>::max());
+      for (Index k = 0; k < nnz_; ++k) owner[std::size_t(A.innerIndexPtr()[k])] = rank;
+      min(owner);
+      std::vector<Index> begin(std::size_t(size) + 1, 0);
+      for (Index i = 0; i < n_; ++i) {
+        if (owner[std::size_t(i)] >= size)
+          throw PetscError("PETSc: row " + std::to_string(i) + " of the summed matrix has no entry on any rank");
+        ++begin[std::size_t(owner[std::size_t(i)]) + 1];
       }
+      for (int p = 0; p < size; ++p) begin[std::size_t(p) + 1] += begin[std::size_t(p)];
+      row_begin_ = begin[std::size_t(rank)], row_end_ = begin[std::size_t(rank) + 1];
+      local = PetscInt(row_end_ - row_begin_);
+      perm_.resize(std::size_t(n_));
+      for (Index i = 0; i < n_; ++i) {
+        const int p = owner[std::size_t(i)];
+        perm_[std::size_t(i)] = PetscInt(begin[std::size_t(p)]++);
+        if (p == rank) owned_.push_back(i);
+      }
+      ci.reserve(std::size_t(nnz_)), cj.reserve(std::size_t(nnz_)), position_.reserve(std::size_t(nnz_));
+      for (Index j = 0; j < n_; ++j)  // every entry of the part: PETSc sends the others' rows
+        for (Index k = A.outerIndexPtr()[j]; k < A.outerIndexPtr()[j + 1]; ++k)
+          ci.push_back(perm_[std::size_t(A.innerIndexPtr()[k])]), cj.push_back(perm_[std::size_t(j)]),
+              position_.push_back(k);
+    }
     values_.resize(position_.size());
     ALEFSI_PETSC(MatCreate(PETSC_COMM_WORLD, &mat_));
     ALEFSI_PETSC(MatSetSizes(mat_, local, local, global, global));
@@ -229,7 +406,7 @@ class PetscSystem {
     ALEFSI_CHECK_ARG(b.size() == n_, "b", "has ", b.size(), " entries, the matrix ", n_, " rows");
     PetscScalar* pb = nullptr;
     ALEFSI_PETSC(VecGetArray(b_, &pb));
-    for (Index i = row_begin_; i < row_end_; ++i) pb[i - row_begin_] = b[i];
+    for (std::size_t k = 0; k < owned_.size(); ++k) pb[k] = b[owned_[k]];
     ALEFSI_PETSC(VecRestoreArray(b_, &pb));
     ALEFSI_PETSC(KSPSolve(ksp_, b_, x_));
     KSPConvergedReason local;
@@ -255,7 +432,7 @@ class PetscSystem {
     VecX x(n_);
     const PetscScalar* px = nullptr;
     ALEFSI_PETSC(VecGetArrayRead(x_all_, &px));
-    for (Index i = 0; i < n_; ++i) x[i] = Real(px[i]);
+    for (Index i = 0; i < n_; ++i) x[i] = Real(px[petsc_row(i)]);
     ALEFSI_PETSC(VecRestoreArrayRead(x_all_, &px));
     return x;
   }
@@ -263,8 +440,13 @@ class PetscSystem {
   KSP ksp() const { return ksp_; }
   ::Mat matrix() const { return mat_; }
   Index rows() const { return n_; }
+  /// This rank's rows of PETSc's matrix [row_begin, row_end), in PETSc's numbering.
   Index row_begin() const { return row_begin_; }
   Index row_end() const { return row_end_; }
+  /// The library's index of each of this rank's rows, in PETSc's order.
+  const std::vector<Index>& owned() const { return owned_; }
+  /// PETSc's row of the library's unknown i.
+  Index petsc_row(Index i) const { return perm_.empty() ? i : Index(perm_[std::size_t(i)]); }
   int iterations() const { return iterations_; }
   const std::string& prefix() const { return prefix_; }
   /// The value of `-<prefix><name>` in the options database ("" when unset).
@@ -309,6 +491,9 @@ class PetscSystem {
   Index n_ = 0, nnz_ = 0, row_begin_ = 0, row_end_ = 0;
   std::uint64_t hash_ = 0;
   std::vector<Index> position_;       // value-array positions of this rank's entries (COO order)
+  std::vector<Index> owned_;          // the library's indices of this rank's rows (PETSc order)
+  std::vector<PetscInt> perm_;        // PETSc's row of each unknown (empty: the same index)
+  bool summed_ = false;
   std::vector<PetscScalar> values_;  // their values, in COO order
   int iterations_ = 0;
   bool first_ = true;
@@ -337,7 +522,19 @@ class PetscDirect {
     sys_.setup();
   }
   VecX solve(const VecX& b) { return sys_.solve(b); }
-  /// This rank's rows [row_begin, row_end).
+  /// Assembly in parts (la/partition.hpp): with `set_summed(true)` on more than one rank, each
+  /// rank passes the matrix of its cells and the solve is with their sum (PetscSystem::set_summed).
+  void set_summed(bool summed) { sys_.set_summed(summed); }
+  int parts() const { return PetscSession::size(); }
+  int part() const { return PetscSession::rank(); }
+  /// The rank of each cell when assembling in parts (detail::petsc_partition: PT-Scotch).
+  template <int Dim>
+  std::vector<int> partition(const Mesh<Dim>& mesh) const {
+    return detail::petsc_partition(mesh);
+  }
+  void sum(VecX& v) const { detail::PetscSystem::sum(v); }
+  void min(std::vector<int>& w) const { detail::PetscSystem::min(w); }
+  /// This rank's rows [row_begin, row_end) of PETSc's matrix.
   Index row_begin() const { return sys_.row_begin(); }
   Index row_end() const { return sys_.row_end(); }
   KSP ksp() const { return sys_.ksp(); }
@@ -409,6 +606,18 @@ class PetscKrylov {
     sys_.setup();
   }
   VecX solve(const VecX& b) { return sys_.solve(b); }
+  /// Assembly in parts (la/partition.hpp): with `set_summed(true)` on more than one rank, each
+  /// rank passes the matrix of its cells and the solve is with their sum (PetscSystem::set_summed).
+  void set_summed(bool summed) { sys_.set_summed(summed); analyzed_ = analyzed_ && sys_.summed() == summed; }
+  int parts() const { return PetscSession::size(); }
+  int part() const { return PetscSession::rank(); }
+  /// The rank of each cell when assembling in parts (detail::petsc_partition: PT-Scotch).
+  template <int Dim>
+  std::vector<int> partition(const Mesh<Dim>& mesh) const {
+    return detail::petsc_partition(mesh);
+  }
+  void sum(VecX& v) const { detail::PetscSystem::sum(v); }
+  void min(std::vector<int>& w) const { detail::PetscSystem::min(w); }
 
   int iterations() const { return sys_.iterations(); }
   Index n_pressure() const { return split_.n_pressure; }
@@ -421,11 +630,14 @@ class PetscKrylov {
 
  private:
   // The splits' index sets: this rank's rows of split 0 (velocities [0, nu) and bodies
-  // [nu + np, n)) and of split 1 (pressures)
+  // [nu + np, n)) and of split 1 (pressures), in PETSc's numbering
   void make_splits() {
     const Index p0 = split_.n_velocity, e0 = p0 + split_.n_pressure;
     std::vector<PetscInt> rows0, rows1;
-    for (Index i = sys_.row_begin(); i < sys_.row_end(); ++i) (i >= p0 && i < e0 ? rows1 : rows0).push_back(PetscInt(i));
+    for (std::size_t k = 0; k < sys_.owned().size(); ++k) {
+      const Index i = sys_.owned()[k];
+      (i >= p0 && i < e0 ? rows1 : rows0).push_back(PetscInt(sys_.row_begin() + Index(k)));
+    }
     destroy_splits();
     ALEFSI_PETSC(ISCreateGeneral(PETSC_COMM_WORLD, PetscInt(rows0.size()), rows0.data(), PETSC_COPY_VALUES, &is0_));
     ALEFSI_PETSC(ISCreateGeneral(PETSC_COMM_WORLD, PetscInt(rows1.size()), rows1.data(), PETSC_COPY_VALUES, &is1_));
@@ -484,26 +696,40 @@ class PetscKrylov {
   bool mass_path(const SaddlePointBlocks& b) const {
     return b.mass_coefficient == 0 && b.pressure_mass.rows() == b.n_pressure && b.n_pressure > 0;
   }
-  // Visits this rank's entries of S~ (its pressure rows, in the order set_schur_matrix and
-  // set_schur_values share): f(i, j, value) with i, j in split 1's numbering.
+  // Visits this rank's entries of S~ (in the order set_schur_matrix and set_schur_values share):
+  // f(i, j, value) with i, j in split 1's numbering; M_p's entries of this rank's pressure rows,
+  // and A's pressure block in this rank's rows (its whole part when the matrix is summed).
   template <class F>
   void schur_entries(const SparseMatrix& A, F&& f) const {
     const SparseMatrix& Mp = blocks_->pressure_mass;
     const Index p0 = split_.n_velocity, np = split_.n_pressure;
-    const Index lo = std::clamp(sys_.row_begin() - p0, Index(0), np), hi = std::clamp(sys_.row_end() - p0, Index(0), np);
+    auto mine = [&](Index j) { return schur_index_[std::size_t(j)] >= schur_lo_ && schur_index_[std::size_t(j)] < schur_hi_; };
     for (Index j = 0; j < np; ++j) {
+      const PetscInt sj = schur_index_[std::size_t(j)];
       for (SparseMatrix::InnerIterator it(Mp, j); it; ++it)
-        if (it.row() >= lo && it.row() < hi) f(it.row(), j, -it.value() / blocks_->mu);
+        if (mine(it.row())) f(schur_index_[std::size_t(it.row())], sj, -it.value() / blocks_->mu);
       for (SparseMatrix::InnerIterator it(A, p0 + j); it; ++it)  // COO sums repeated entries
-        if (it.row() >= p0 + lo && it.row() < p0 + hi) f(it.row() - p0, j, it.value());
+        if (it.row() >= p0 && it.row() < p0 + np && (sys_.summed() || mine(it.row() - p0)))
+          f(schur_index_[std::size_t(it.row() - p0)], sj, it.value());
     }
   }
   // S~ = -C - M_p / mu (PETSc's Schur complement is A_pp - B A^-1 B^T, negative: A_pp = -C),
-  // this rank's pressure rows, in the numbering of split 1 (PETSc numbers a split's unknowns in
-  // rank order: this rank's pressures are contiguous there).
+  // in the numbering of split 1: PETSc numbers a split's unknowns in the order of its rows, so a
+  // pressure's index there is the count of pressures before its row, and this rank's pressures
+  // are [schur_lo_, schur_hi_).
   void set_schur_matrix(const SparseMatrix& A) {
     const Index p0 = split_.n_velocity, np = split_.n_pressure;
-    const Index lo = std::clamp(sys_.row_begin() - p0, Index(0), np), hi = std::clamp(sys_.row_end() - p0, Index(0), np);
+    std::vector<std::pair<Index, Index>> rows(static_cast<std::size_t>(np));  // (PETSc row, pressure)
+    for (Index j = 0; j < np; ++j) rows[std::size_t(j)] = {sys_.petsc_row(p0 + j), j};
+    std::sort(rows.begin(), rows.end());
+    schur_index_.resize(std::size_t(np));
+    schur_lo_ = schur_hi_ = 0;
+    for (Index k = 0; k < np; ++k) {
+      schur_index_[std::size_t(rows[std::size_t(k)].second)] = PetscInt(k);
+      if (rows[std::size_t(k)].first < sys_.row_begin()) schur_lo_ = schur_hi_ = PetscInt(k + 1);
+      else if (rows[std::size_t(k)].first < sys_.row_end()) schur_hi_ = PetscInt(k + 1);
+    }
+    const PetscInt lo = schur_lo_, hi = schur_hi_;
     std::vector<PetscInt> ci, cj;
     schur_entries(A, [&](Index i, Index j, Real) { ci.push_back(PetscInt(i)), cj.push_back(PetscInt(j)); });
     if (schur_pre_) MatDestroy(&schur_pre_);
@@ -534,10 +760,14 @@ class PetscKrylov {
   IS is0_ = nullptr, is1_ = nullptr;
   ::Mat schur_pre_ = nullptr;
   std::vector<PetscScalar> schur_values_;
+  std::vector<PetscInt> schur_index_;  // each pressure's index in split 1
+  PetscInt schur_lo_ = 0, schur_hi_ = 0;  // this rank's range there
   bool analyzed_ = false, configured_ = false, use_mass_ = false;
 };
 
 static_assert(LinearSolver<PetscDirect> && DirectSolver<PetscDirect>, "PetscDirect must model DirectSolver");
 static_assert(LinearSolver<PetscKrylov<3>>, "PetscKrylov must model LinearSolver");
+static_assert(SummedPartsSolver<PetscDirect> && SummedPartsSolver<PetscKrylov<3>>,
+              "the PETSc policies must take assembly in parts");
 
 }  // namespace alefsi

@@ -35,6 +35,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -135,6 +136,9 @@ class AleFlow {
   const VecX& field() const { return state_.U[0]; }
   /// Mesh velocity at level n (per node).
   const std::vector<Vec<D>>& mesh_velocity() const { return state_.V; }
+  /// The cells whose matrix this process assembles: all, or its part under MPI with a solver
+  /// that sums the parts (sim/discretisation.hpp).
+  Index assembled_cells() const { return disc_.assembled_cells(); }
   /// Smallest Mesh::quality over the cells.
   Real worst_quality() const { return alefsi::worst_quality(mesh_); }
 
@@ -407,6 +411,15 @@ class AleFlow {
   void setup() {
     bodies_.attach(mesh_);
     disc_.constrain(dirichlet_, bodies_);
+    if (disc_.in_parts()) {  // a free body's own terms enter the part of the lowest process touching it
+      std::vector<int> first(bodies_.size(), std::numeric_limits<int>::max());
+      for (std::size_t k = 0; k < bodies_.size(); ++k)
+        if (const Index z = bodies_.first_unknown(k, disc_.constraints()); z >= 0 && disc_.touches(z))
+          first[k] = disc_.part();
+      disc_.min_parts(first);
+      body_jacobian_here_.assign(bodies_.size(), 0);
+      for (std::size_t k = 0; k < bodies_.size(); ++k) body_jacobian_here_[k] = first[k] == disc_.part();
+    }
     bodies_.check_radii(mesh_, state_.bodies);
     if (state_.stats.steps == 0) bodies_.check_slip(mesh_, state_.bodies);
     contact_->set_walls(mesh_, bodies_.tags());
@@ -539,12 +552,14 @@ class AleFlow {
     VecX u = cons.restrict_free(s.U[0]);
     bodies_.initial_guess(cons, s.bodies, u);
     const auto residual = [&](const VecX& uu, SparseMatrix& J, VecX& r) {
-      disc_.assembler().assemble(disc_.kernel(), cons.expand(uu), &J, &r);
-      bodies_.add_rows(s.bodies, c, cons, uu, r, J, gravity_, *contact_, t1);
+      disc_.assemble(cons.expand(uu), &J, &r);
+      bodies_.add_rows(s.bodies, c, cons, uu, r, J, gravity_, *contact_, t1,
+                       disc_.in_parts() ? &body_jacobian_here_ : nullptr);
     };
-    const NewtonOptions no{.linear = opt_.linearisation != Linearisation::newton,
-                           .max_iterations = opt_.max_newton,
-                           .tolerance = opt_.newton_tolerance};
+    NewtonOptions no{.linear = opt_.linearisation != Linearisation::newton,
+                     .max_iterations = opt_.max_newton,
+                     .tolerance = opt_.newton_tolerance};
+    if (disc_.in_parts()) no.sum_parts = [this](VecX& v) { disc_.sum_parts(v); };
     const NewtonReport nr = newton_solve(residual, disc_.linear_solve(), disc_.jacobian(), u, no);
     rep.newton_iterations = nr.iterations, rep.residuals = nr.residuals;
     rep.t_assembly = nr.t_assembly, rep.t_factorize = nr.t_factorize, rep.t_solve = nr.t_solve;
@@ -600,6 +615,7 @@ class AleFlow {
   std::unique_ptr<Remesher<D>> remesher_;
   std::unique_ptr<QuadraticGeometry<D>> geometry_;  // curved boundaries (null: straight cells)
   NodeVelocities<D> body_nodes_;  // the step's surface node velocities (scratch)
+  std::vector<char> body_jacobian_here_;  // in parts: the bodies whose own Jacobian terms this process adds
 };
 
 /// The mesh stored in a checkpoint written by AleFlow::save_checkpoint (to build the flow that

@@ -321,9 +321,13 @@ class BodySystem {
   /// 3D) - M g - external load - contact force, and their Jacobian (exact, gyroscopic term
   /// included) on each body's diagonal block of J. The contact forces come from `contact` at
   /// the bodies' velocities at t^{n+1} = t1 (the unknowns of free bodies, the given motion of
-  /// driven ones); each body's total is recorded in its state.
+  /// driven ones); each body's total is recorded in its state. With `jacobian_here` (J
+  /// assembled in parts, one per MPI process: la/partition.hpp), body k's terms enter J only
+  /// where jacobian_here[k] is set (one process; r is whole and takes them everywhere).
   void add_rows(std::vector<State>& states, const StepCoefficients& c, const DofConstraints& cons, const VecX& u, VecX& r,
-                SparseMatrix& J, const Vec<D>& gravity, const ContactModel<D>& contact, Real t1) const {
+                SparseMatrix& J, const Vec<D>& gravity, const ContactModel<D>& contact, Real t1,
+                const std::vector<char>* jacobian_here = nullptr) const {
+    auto here = [&](std::size_t k) { return !jacobian_here || (*jacobian_here)[k]; };
     const Real a0 = c.flow_bdf[0];
     for (std::size_t k = 0; k < entries_.size(); ++k) {
       const auto& e = entries_[k];
@@ -333,6 +337,7 @@ class BodySystem {
       const Index row = cons.extra_unknown(e.extra);
       const Velocity Z = u.template segment<n_dof>(row);
       r.template segment<n_dof>(row) += inertia(e, s, c, Z) - weight(e, gravity) - M::external_load(e.data);
+      if (!here(k)) continue;
       const auto Jb = M::inertia_jacobian(e.data, e.th_next, Z, a0, c.dt);
       for (int i = 0; i < n_dof; ++i)
         for (int j = 0; j < n_dof; ++j)
@@ -348,11 +353,17 @@ class BodySystem {
       if (!M::is_free(entries_[b].data)) return;
       const Index row = cons.extra_unknown(entries_[b].extra);
       r.template segment<D>(row) -= F;
+      if (!here(std::size_t(b))) return;
       for (int i = 0; i < D; ++i)
         for (int j = 0; j < D; ++j) J.coeffRef(row + i, row + j) -= dF(i, j);
     });
   }
 
+  /// The first of the n_dof unknowns of body k (-1: a driven body has none).
+  Index first_unknown(std::size_t k, const DofConstraints& cons) const {
+    const auto& e = entries_.at(k);
+    return M::is_free(e.data) ? cons.extra_unknown(e.extra) : Index(-1);
+  }
   /// Whether body k is free (its velocity solved for) rather than driven.
   bool is_free(std::size_t k) const { return M::is_free(entries_.at(k).data); }
   /// Z^{n+1} of body k after the solve (`u` the unknowns at t1): its unknowns if it is free,

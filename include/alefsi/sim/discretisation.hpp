@@ -14,6 +14,14 @@
 /// velocity mass with gamma = rho a_0 / (theta dt), refreshed when the pattern or gamma
 /// changes (`prepare_solver`).
 ///
+/// Assembly in parts: with a solver that takes each process's part of the matrix
+/// (SummedPartsSolver, la/partition.hpp: PetscKrylov and PetscDirect under MPI) on more than one
+/// process, each process assembles the Jacobian of its own cells only (the solver's partition of
+/// the cells when it has one, `partition(mesh)`: PT-Scotch through PETSc; else a Morton part,
+/// `partition_cells`), with the pattern of those cells; the residual is summed over the
+/// processes, so that it is whole everywhere. Factorisation reuse is off then (it would need
+/// products with the whole matrix).
+///
 ///     Discretisation<Cfg> disc(mesh, options);            // or (mesh, options, solver options)
 ///     disc.constrain(dirichlet, bodies);
 ///     disc.assembler().assemble(disc.kernel(), field, &disc.jacobian(), &r);
@@ -25,6 +33,7 @@
 #include "alefsi/fem/constraints.hpp"
 #include "alefsi/fem/dofmap.hpp"
 #include "alefsi/la/assembler.hpp"
+#include "alefsi/la/partition.hpp"
 #include "alefsi/la/saddle_point_blocks.hpp"
 #include "alefsi/mesh/mesh.hpp"
 #include "alefsi/physics/mesh_motion.hpp"
@@ -90,12 +99,67 @@ class Discretisation {
                                         [&](int tag) { return bodies.has_tag(tag) || dirichlet.count(tag) > 0; });
     if (pinned_) cons_->fix(space_->pressure_field(0), 0.0);
     cons_->finalize();
-    asmb_ = std::make_unique<FlowAssembler>(
-        space_->mesh().n_cells(), [&](Index c) { return space_->cell_field_dofs(c); }, *cons_);
+    in_parts_ = false;
+    if constexpr (SummedPartsSolver<Solver>) {
+      Solver& s = solve_.solver();
+      in_parts_ = s.parts() > 1;
+      s.set_summed(in_parts_);
+      if (in_parts_) solve_.set_reuse({.enabled = false});
+    }
+    if (in_parts_) {
+      std::vector<int> cell_part;  // the solver's partitioner (PETSc: PT-Scotch), else the Morton curve
+      if constexpr (requires { solve_.solver().partition(space_->mesh()); })
+        cell_part = solve_.solver().partition(space_->mesh());
+      if (cell_part.empty()) cell_part = partition_cells(space_->mesh(), parts());
+      own_cells_ = cells_of_part(cell_part, part());
+      asmb_ = std::make_unique<FlowAssembler>(
+          Index(own_cells_.size()), [&](Index i) { return space_->cell_field_dofs(own_cells_[std::size_t(i)]); },
+          *cons_, AssembledCells::part);
+      touched_.assign(std::size_t(cons_->n_unknowns()), 0);
+      for (Index c : own_cells_)
+        for (Index f : space_->cell_field_dofs(c))
+          for (Index u : cons_->indices(f)) touched_[std::size_t(u)] = 1;
+    } else {
+      own_cells_.clear(), touched_.clear();
+      asmb_ = std::make_unique<FlowAssembler>(
+          space_->mesh().n_cells(), [&](Index c) { return space_->cell_field_dofs(c); }, *cons_);
+    }
     asmb_->set_threads(opt_.threads);
     gamma_ = -1;
   }
   bool constrained() const { return cons_ != nullptr; }
+
+  /// The Jacobian (of this process's cells, in parts) into J and the residual (whole) into r, at
+  /// `field`; either may be null.
+  void assemble(const VecX& field, SparseMatrix* J, VecX* r) {
+    if (!in_parts_) return asmb_->assemble(*kernel_, field, J, r);
+    asmb_->assemble(PartKernel<Kernel>{kernel_.get(), &own_cells_}, field, J, r);
+    if (r) sum_parts(*r);
+  }
+  /// Whether each process assembles its part (class comment); the parts, this process's part.
+  bool in_parts() const { return in_parts_; }
+  int parts() const {
+    if constexpr (SummedPartsSolver<Solver>) return solve_.solver().parts();
+    return 1;
+  }
+  int part() const {
+    if constexpr (SummedPartsSolver<Solver>) return solve_.solver().part();
+    return 0;
+  }
+  /// Sums v over the processes (in parts; nothing otherwise).
+  void sum_parts(VecX& v) const {
+    if constexpr (SummedPartsSolver<Solver>)
+      if (in_parts_) solve_.solver().sum(v);
+  }
+  /// The elementwise minimum of w over the processes (in parts; nothing otherwise).
+  void min_parts(std::vector<int>& w) const {
+    if constexpr (SummedPartsSolver<Solver>)
+      if (in_parts_) solve_.solver().min(w);
+  }
+  /// Cells this process assembles.
+  Index assembled_cells() const { return in_parts_ ? Index(own_cells_.size()) : space_->mesh().n_cells(); }
+  /// Whether this process's cells touch unknown u (always, unless in parts).
+  bool touches(Index u) const { return !in_parts_ || touched_[std::size_t(u)]; }
 
   /// Isoparametric P2 (Taylor–Hood): the kernel integrates the curved cells of `g` and the
   /// velocity's edge DOFs sit at its points; the kernel gets the edge points' velocities each
@@ -170,7 +234,10 @@ class Discretisation {
   Real gamma_ = -1;
   VecX hist_, ustar_;  // the step's kernel inputs
   const QuadraticGeometry<D>* geometry_ = nullptr;
-  std::vector<Vec<D>> edge_velocity_;  // the step's edge-point velocities (curved geometry)
+  std::vector<Vec<D>> edge_velocity_;
+  bool in_parts_ = false;
+  std::vector<Index> own_cells_;  // in parts: this process's cells
+  std::vector<char> touched_;     // in parts: the unknowns its cells touch  // the step's edge-point velocities (curved geometry)
 };
 
 }  // namespace alefsi

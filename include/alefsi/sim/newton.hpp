@@ -30,6 +30,7 @@
 ///     NewtonReport rep = newton_solve([&](const VecX& u, SparseMatrix& J, VecX& r) { ... }, lin, u, {});
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <string>
 #include <utility>
@@ -50,6 +51,9 @@ struct NewtonOptions {
   Real absolute_tolerance = 1e-13;
   Real scaled_tolerance = 1e-14;  ///< on max_i |r_i| / (sum_j |J_ij| max|u|)
   Real step_tolerance = 1e-12;   ///< on max|du| / max|u|
+  /// With J assembled in parts (one per MPI process, la/partition.hpp): sums a vector over the
+  /// processes (the row sums of the scaled-residual test). Empty: J is whole.
+  std::function<void(VecX&)> sum_parts{};
 };
 
 struct NewtonReport {
@@ -64,11 +68,13 @@ struct NewtonReport {
 
 namespace detail {
 /// max_i |r_i| / (sum_j |J_ij| max|u|) (0 for an empty or zero r).
-inline Real scaled_residual(const SparseMatrix& J, const VecX& r, const VecX& u) {
+inline Real scaled_residual(const SparseMatrix& J, const VecX& r, const VecX& u,
+                            const std::function<void(VecX&)>& sum_parts = {}) {
   if (r.size() == 0) return 0;
   VecX rows = VecX::Zero(J.rows());
   for (Index c = 0; c < J.outerSize(); ++c)
     for (SparseMatrix::InnerIterator it(J, c); it; ++it) rows[it.row()] += std::abs(it.value());
+  if (sum_parts) sum_parts(rows);
   const Real un = u.size() ? u.template lpNorm<Eigen::Infinity>() : 0.0;
   Real worst = 0;
   for (Index i = 0; i < r.size(); ++i) {
@@ -99,7 +105,7 @@ NewtonReport newton_solve(Residual&& residual, LinearSolve<S>& lin, SparseMatrix
     if (r0 < 0) r0 = rn;
     if (!opt.linear && it > 0) {
       if (rn <= opt.tolerance * r0 + opt.absolute_tolerance) break;
-      if (detail::scaled_residual(J, r, u) <= opt.scaled_tolerance) {
+      if (detail::scaled_residual(J, r, u, opt.sum_parts) <= opt.scaled_tolerance) {
         rep.stop = NewtonReport::Stop::scaled_residual;
         break;
       }

@@ -381,10 +381,7 @@ void print_report(const StepReport& rep) {
 
 int squirmer_main(int argc, char** argv) try {
 #ifdef ALEFSI_SQUIRMER_PETSC
-  for (int i = 1; i < argc; ++i)  // PETSc's options: after "--"
-    if (std::string(argv[i]) == "--") argc = i;
-  const bool root = PetscSession::rank() == 0;
-  if (!root) std::cout.rdbuf(nullptr);  // rank 0 prints
+  const bool root = PetscSession::rank() == 0;  // it prints (petsc_main) and writes
 #else
   const bool root = true;
 #endif
@@ -493,16 +490,13 @@ int squirmer_main(int argc, char** argv) try {
   return 0;
 } catch (const std::exception& e) {
   std::cerr << "sphere_squirmer: " << e.what() << "\n";
-#ifdef ALEFSI_SQUIRMER_PETSC
-  if (PetscSession::size() > 1) MPI_Abort(PETSC_COMM_WORLD, 1);  // the other ranks may wait for this one
-#endif
   return 1;
 }
 
 int main(int argc, char** argv) {
 #ifdef ALEFSI_SQUIRMER_PETSC
-  // outside squirmer_main's handler: PetscFinalize would wait for the other ranks before MPI_Abort
-  PetscSession petsc(argc, argv);
-#endif
+  return petsc_main(argc, argv, squirmer_main);  // PETSc's options after "--"; all ranks end on an error
+#else
   return squirmer_main(argc, argv);
+#endif
 }

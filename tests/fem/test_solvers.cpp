@@ -404,6 +404,7 @@ TEST_CASE("SaddlePointGmres solves 3D Stokes (P2/P1, P1/P1-GLS) and agrees with 
   }
   // bad input
   CHECK_THROWS_AS(SaddlePointGmres<3>(KrylovOptions{.tolerance = 0}), InvalidArgument);
+  CHECK_THROWS_WITH(SaddlePointGmres<3>(KrylovOptions{.augment = -1}), Catch::Contains("augment"));
   SaddlePointGmres<3> k;
   SparseMatrix spd(2, 2);
   spd.insert(0, 0) = 1, spd.insert(1, 1) = 2;

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "alefsi/mesh/io/gmsh.hpp"
+#include "alefsi/scenes/settling_sphere.hpp"
 #include "alefsi/sim/ale_flow.hpp"
 
 using namespace alefsi;
@@ -439,4 +440,28 @@ TEST_CASE("massless squirmer sphere (paper 6.1): V = -<u_s> and w = -3 / (8 R) e
     // the moment of the same tolerance in force, applied at the walls (distance >= H = 2.5)
     CHECK(walls.tail<3>().norm() < 0.02 * 6 * pi * mu * R * V_exact.norm() * 2.5);
   }
+}
+
+TEST_CASE("scenes::SettlingSphere: bad parameters are refused by name; the wall factor of concentric spheres",
+          "[bodies3d][scenes][quick]") {
+  using scenes::SettlingSphere;
+  auto refused = [](SettlingSphere s, const char* name) {
+    CAPTURE(name);
+    CHECK_THROWS_WITH(s.validate(), Catch::Contains(std::string("'") + name + "'"));
+    CHECK_THROWS_AS(s.mesh(), InvalidArgument);  // nothing built
+  };
+  SettlingSphere s;
+  s.a = 0, refused(s, "a");
+  s = {}, s.b = 0.2, refused(s, "b");
+  s = {}, s.rho_s = -1, refused(s, "rho_s");
+  s = {}, s.mu = std::nan(""), refused(s, "mu");
+  s = {}, s.layers = 0, refused(s, "layers");
+  s = {}, s.grading = 0.5, refused(s, "grading");
+  // K(a / b) -> 1 for a small sphere (Stokes' drag), K(1/8) = 1.382 (Haberman & Sayre 1958)
+  s = {}, s.a = 1e-4;
+  CHECK(s.wall_factor() == Approx(1.0).margin(1e-3));
+  s = {};
+  CHECK(s.wall_factor() == Approx(1.382).margin(5e-4));
+  const Real stokes = 2.0 / 9.0 * (s.rho_s - s.rho_f) * 980 * s.a * s.a / s.mu;
+  CHECK(s.terminal_speed() == Approx(stokes / s.wall_factor()).epsilon(1e-12));
 }

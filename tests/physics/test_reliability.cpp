@@ -335,6 +335,15 @@ TEST_CASE("a scene that cannot run is refused before anything is written, naming
   // the same field made tangential runs; so does a non-finite slip not (named)
   auto good = flow_with(tangential_slip(Vec<2>(1, 0)));
   CHECK_NOTHROW(good->prepare());
+  {  // a rank that is not the writer (RunOptions::writer, MPI) steps and writes nothing
+    auto silent = flow_with(tangential_slip(Vec<2>(1, 0)));
+    RunOptions quiet_rank = quiet(0.01, 0.02);
+    quiet_rank.output = out.path / "not_the_writer";
+    quiet_rank.vtu_every = 1, quiet_rank.checkpoint_every = 1, quiet_rank.writer = false;
+    const RunSummary done = run(*silent, quiet_rank);
+    CHECK(done.steps == 2);
+    CHECK(!fs::exists(quiet_rank.output));
+  }
   auto nan = flow_with([](const Vec<2>&) { return Vec<2>(std::numeric_limits<Real>::quiet_NaN(), 0); });
   CHECK(message([&] { nan->prepare(); }).find("not finite") != std::string::npos);
   // gravity with a NaN, named

@@ -170,11 +170,9 @@ TEST_CASE("MatPartitioning (PT-Scotch) gives every rank the same balanced parts 
   PetscDirect().min(low), PetscDirect().min(high);  // the same array on every rank: min = max
   CHECK(low == part);
   CHECK(high == minus);
+  REQUIRE(std::all_of(part.begin(), part.end(), [&](int p) { return p >= 0 && p < parts; }));
   std::vector<Index> size(std::size_t(parts), 0);
-  for (int p : part) {
-    REQUIRE((p >= 0 && p < parts));
-    ++size[std::size_t(p)];
-  }
+  for (int p : part) ++size[std::size_t(p)];
   const Real mean = Real(mesh.n_cells()) / parts;
   CHECK(*std::max_element(size.begin(), size.end()) <= 1.01 * mean + 1);
   std::cout << "PT-Scotch parts of " << mesh.n_cells() << " cells:";
@@ -199,6 +197,19 @@ TEST_CASE("PetscKrylov: bad input and a solve that cannot converge are typed err
                                         Catch::Contains("e-"));
   VecX wrong = VecX::Ones(3);
   CHECK_THROWS_AS(few.solve(wrong), InvalidArgument);
+  // in parts a rank's diagonal does not show the pressures: the blocks are needed, and every
+  // rank refuses alike; an uncompressed part is refused on every rank too
+  PetscKrylov<3> parts_without_blocks;
+  parts_without_blocks.set_summed(true);
+  if (PetscSession::size() > 1)
+    CHECK_THROWS_WITH(parts_without_blocks.factorize(s.A), Catch::Contains("set_blocks"));
+  SparseMatrix loose = s.A;
+  if (PetscSession::rank() == 0) loose.coeffRef(0, 0) += 0;  // still compressed
+  if (PetscSession::rank() == 0) loose.uncompress();
+  PetscDirect parts_lu;
+  parts_lu.set_summed(true);
+  if (PetscSession::size() > 1)
+    CHECK_THROWS_WITH(parts_lu.factorize(loose), Catch::Contains("compressed"));
   // a singular matrix: MUMPS's failure is a SolverError on every rank alike (the reason is
   // agreed across ranks before anyone throws), not a hang
   SparseMatrix singular(4, 4);
@@ -274,6 +285,20 @@ TEST_CASE("AleFlow with PetscKrylov<3> or PetscDirect: 3D Navier–Stokes steps 
     CHECK(total == mesh.n_cells());
     if (PetscSession::size() > 1) CHECK(mine < mesh.n_cells());
   }
+  // a checkpoint of the serial flow (its direct solver keeps its factors for reuse) continues
+  // on N ranks in parts, where the flow's factors are not reused: as the serial flow does
+  const auto file = std::filesystem::temp_directory_path() /
+                    ("alefsi_test_bodies3d_" + std::to_string(PetscSession::rank()) + ".bin");
+  serial.save_checkpoint(file);
+  AleFlow<FlowConfig<3, TaylorHood, BDF2_BDF2E>::with_solver<PetscKrylov<3>>> resumed(read_checkpoint_mesh<3>(file),
+                                                                                     FlowOptions{1.0, 1.0});
+  resumed.set_velocity(1, [&](const alefsi::Vec<3>& x, Real) { return alefsi::Vec<3>(gamma * x[1], 0.0, 0.0); });
+  resumed.add_body(sphere_body(5, alefsi::Vec<3>::Zero(), a, 1.0));
+  resumed.load_checkpoint(file);
+  std::filesystem::remove(file);
+  serial.step(0.05), resumed.step(0.05);
+  CHECK((resumed.field() - serial.field()).norm() <= 1e-7 * serial.field().norm());
+  CHECK((resumed.body_centre(0) - serial.body_centre(0)).norm() <= 1e-9 * a);
 }
 
 TEST_CASE("a sphere settling in a spherical container: 10 steps through run() on N ranks follow the serial "

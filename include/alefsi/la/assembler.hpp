@@ -951,7 +951,7 @@ class Assembler {
     const Index ng = Index(gfirst_.size()) - 1;
     const Index* bg = s.bg.data();
     const Index* bstart = blk_start_.data();
-    // `used`: the incidences' storage (touched already; one per block, so at least ng)
+    // `used`: the incidences' storage (touched already; one per block)
     std::uint32_t* used = s.inc.resize_for_overwrite(std::size_t(ng));
     Index base = 0, left = nch;
     while (left > 0) {  // one round of up to 32 colours over the chunks still uncoloured

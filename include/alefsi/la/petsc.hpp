@@ -5,8 +5,8 @@
 ///
 /// The model is a shared mesh: every rank holds the whole mesh and runs the whole program on it,
 /// and the matrix and its solves are distributed. A flow (sim/discretisation.hpp) on several
-/// ranks assembles in parts: each rank the Jacobian of its own cells (a Morton part,
-/// la/partition.hpp) with the library's kernels, into the pattern of those cells, and the
+/// ranks assembles in parts: each rank the Jacobian of its own cells (PT-Scotch's part through
+/// MatPartitioning, `petsc_partition`; a Morton part, la/partition.hpp, without a partitioner) with the library's kernels, into the pattern of those cells, and the
 /// residual is summed over the ranks (`set_summed(true)`). The rows of PETSc's AIJ matrix
 /// (MPIAIJ on several ranks) belong to the lowest rank whose cells touch them and are numbered
 /// rank after rank; each rank hands its part's entries to PETSc's COO interface, which sums the
@@ -199,25 +199,28 @@ std::vector<int> petsc_partition(const Mesh<D>& mesh) {
       const Index other = fc[0] == c ? fc[1] : fc[0];
       if (other >= 0) nbr.push_back(PetscInt(other));
     }
+    std::sort(nbr.begin() + start.back(), nbr.end());  // MatCreateMPIAdj wants each row sorted
     start.push_back(PetscInt(nbr.size()));
   }
   // MatCreateMPIAdj takes arrays from PetscMalloc and frees them with the matrix
   PetscInt *ia = nullptr, *ja = nullptr;
-  ALEFSI_PETSC(PetscMalloc1(start.size(), &ia));
-  ALEFSI_PETSC(PetscMalloc1(std::max<std::size_t>(nbr.size(), 1), &ja));
-  std::copy(start.begin(), start.end(), ia);
-  std::copy(nbr.begin(), nbr.end(), ja);
-  ::Mat adj = nullptr;
+  ::Mat adj = nullptr;  // once created, it owns ia and ja (a failed creation may leak them)
   MatPartitioning mp = nullptr;
   IS is = nullptr, all = nullptr;
   auto release = [&] {
+    const bool arrays_in_adj = adj != nullptr;
     if (all) ISDestroy(&all);
     if (is) ISDestroy(&is);
     if (mp) MatPartitioningDestroy(&mp);
     if (adj) MatDestroy(&adj);
+    if (!arrays_in_adj) PetscFree(ia), PetscFree(ja);
   };
   std::vector<int> part(static_cast<std::size_t>(nc));
   try {
+    ALEFSI_PETSC(PetscMalloc1(start.size(), &ia));
+    ALEFSI_PETSC(PetscMalloc1(std::max<std::size_t>(nbr.size(), 1), &ja));
+    std::copy(start.begin(), start.end(), ia);
+    std::copy(nbr.begin(), nbr.end(), ja);
     ALEFSI_PETSC(MatCreateMPIAdj(PETSC_COMM_WORLD, local, global, ia, ja, nullptr, &adj));
     ALEFSI_PETSC(MatPartitioningCreate(PETSC_COMM_WORLD, &mp));
     ALEFSI_PETSC(MatPartitioningSetAdjacency(mp, adj));
@@ -235,7 +238,6 @@ std::vector<int> petsc_partition(const Mesh<D>& mesh) {
     for (Index c = 0; c < nc; ++c) part[std::size_t(c)] = int(p[c]);
     ALEFSI_PETSC(ISRestoreIndices(all, &p));
   } catch (...) {
-    if (!adj) PetscFree(ia), PetscFree(ja);
     release();
     throw;
   }
@@ -270,7 +272,7 @@ class PetscSystem {
   /// and preconditioner are set by the policy at the next factorisation: `take_first`).
   void analyze(const SparseMatrix& A) {
     ALEFSI_CHECK_ARG(A.rows() == A.cols(), "A", "must be square, got ", A.rows(), " x ", A.cols());
-    ALEFSI_CHECK_ARG(A.isCompressed(), "A", "must be compressed (makeCompressed)");
+    check_compressed(A);
     destroy_pattern();
     try {
       build(A);
@@ -313,6 +315,13 @@ class PetscSystem {
     if (MPI_Bcast(v.data(), n, MPI_DOUBLE, 0, PETSC_COMM_WORLD) != MPI_SUCCESS)
       throw PetscError("PETSc: MPI_Bcast of a summed vector failed");
   }
+  /// Whether `b` holds on every rank.
+  static bool all(bool b) {
+    int v = b;
+    if (MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_INT, MPI_LAND, PETSC_COMM_WORLD) != MPI_SUCCESS)
+      throw PetscError("PETSc: MPI_Allreduce of a flag failed");
+    return v != 0;
+  }
   /// The elementwise minimum of `w` over the ranks.
   static void min(std::vector<int>& w) {
     if (MPI_Allreduce(MPI_IN_PLACE, w.data(), int(w.size()), MPI_INT, MPI_MIN, PETSC_COMM_WORLD) != MPI_SUCCESS)
@@ -324,7 +333,7 @@ class PetscSystem {
   /// (MUMPS) or sets the preconditioner up (BoomerAMG), reusing the symbolic work of the same
   /// pattern.
   bool set_matrix(const SparseMatrix& A) {
-    ALEFSI_CHECK_ARG(A.isCompressed(), "A", "must be compressed (makeCompressed)");
+    check_compressed(A);
     const bool fresh = new_pattern(A);  // one pass over the indices per matrix
     if (fresh) analyze(A);
     set_values(A);
@@ -340,6 +349,13 @@ class PetscSystem {
   void setup() { ALEFSI_PETSC(KSPSetUp(ksp_)); }
 
  private:
+  // A must be compressed; with summed parts the ranks agree first (none throws alone before a
+  // collective call)
+  void check_compressed(const SparseMatrix& A) const {
+    const bool ok = summed_ ? all(A.isCompressed()) : A.isCompressed();
+    ALEFSI_CHECK_ARG(ok, "A", A.isCompressed() ? "is not compressed on another rank" : "must be compressed (makeCompressed)");
+  }
+
   void build(const SparseMatrix& A) {
     n_ = A.rows();
     nnz_ = A.nonZeros();
@@ -501,27 +517,11 @@ class PetscSystem {
 
 }  // namespace detail
 
-/// MUMPS LU through PETSc (file comment). Options: `-pc_factor_mat_solver_type`, `-mat_mumps_*`.
-class PetscDirect {
+namespace detail {
+/// What PetscDirect and PetscKrylov share: the distributed system, and the interface of assembly
+/// in parts (SummedPartsSolver, la/partition.hpp).
+class PetscPolicy {
  public:
-  static constexpr const char* name = "PETSc LU (MUMPS)";
-  static constexpr bool direct = true;
-
-  explicit PetscDirect(std::string prefix = "") : sys_(std::move(prefix)) {}
-  void analyze(const SparseMatrix& A) { sys_.analyze(A); }
-  void factorize(const SparseMatrix& A) {
-    sys_.set_matrix(A);
-    if (sys_.take_first()) {
-      PC pc;
-      ALEFSI_PETSC(KSPSetType(sys_.ksp(), KSPPREONLY));
-      ALEFSI_PETSC(KSPGetPC(sys_.ksp(), &pc));
-      ALEFSI_PETSC(PCSetType(pc, PCLU));
-      ALEFSI_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
-      ALEFSI_PETSC(KSPSetFromOptions(sys_.ksp()));
-    }
-    sys_.setup();
-  }
-  VecX solve(const VecX& b) { return sys_.solve(b); }
   /// Assembly in parts (la/partition.hpp): with `set_summed(true)` on more than one rank, each
   /// rank passes the matrix of its cells and the solve is with their sum (PetscSystem::set_summed).
   void set_summed(bool summed) { sys_.set_summed(summed); }
@@ -539,8 +539,33 @@ class PetscDirect {
   Index row_end() const { return sys_.row_end(); }
   KSP ksp() const { return sys_.ksp(); }
 
- private:
-  detail::PetscSystem sys_;
+ protected:
+  explicit PetscPolicy(std::string prefix) : sys_(std::move(prefix)) {}
+  PetscSystem sys_;
+};
+}  // namespace detail
+
+/// MUMPS LU through PETSc (file comment). Options: `-pc_factor_mat_solver_type`, `-mat_mumps_*`.
+class PetscDirect : public detail::PetscPolicy {
+ public:
+  static constexpr const char* name = "PETSc LU (MUMPS)";
+  static constexpr bool direct = true;
+
+  explicit PetscDirect(std::string prefix = "") : PetscPolicy(std::move(prefix)) {}
+  void analyze(const SparseMatrix& A) { sys_.analyze(A); }
+  void factorize(const SparseMatrix& A) {
+    sys_.set_matrix(A);
+    if (sys_.take_first()) {
+      PC pc;
+      ALEFSI_PETSC(KSPSetType(sys_.ksp(), KSPPREONLY));
+      ALEFSI_PETSC(KSPGetPC(sys_.ksp(), &pc));
+      ALEFSI_PETSC(PCSetType(pc, PCLU));
+      ALEFSI_PETSC(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+      ALEFSI_PETSC(KSPSetFromOptions(sys_.ksp()));
+    }
+    sys_.setup();
+  }
+  VecX solve(const VecX& b) { return sys_.solve(b); }
 };
 
 /// Options of PetscKrylov that are not PETSc's own (those come from the options database).
@@ -555,11 +580,11 @@ struct PetscKrylovOptions {
 /// dimension (the policy's type names it, as SaddlePointGmres<D>'s does; the splits do not
 /// depend on it).
 template <int D>
-class PetscKrylov {
+class PetscKrylov : public detail::PetscPolicy {
  public:
   static constexpr const char* name = "PETSc GMRES+fieldsplit(Schur, BoomerAMG)";
 
-  explicit PetscKrylov(PetscKrylovOptions opt = {}) : opt_(std::move(opt)), sys_(opt_.prefix) {
+  explicit PetscKrylov(PetscKrylovOptions opt = {}) : PetscPolicy(opt.prefix), opt_(std::move(opt)) {
     ALEFSI_CHECK_ARG(opt_.tolerance > 0 && opt_.tolerance < 1, "tolerance", "must be in (0, 1), got ", opt_.tolerance);
     ALEFSI_CHECK_ARG(opt_.max_iterations >= 1, "max_iterations", "must be positive");
     ALEFSI_CHECK_ARG(opt_.restart >= 1, "restart", "must be positive");
@@ -581,12 +606,16 @@ class PetscKrylov {
 
   void analyze(const SparseMatrix& A) {
     analyzed_ = false;
+    // (the same on every rank: no rank throws alone)
+    ALEFSI_CHECK_ARG(!sys_.summed() || blocks_, "A",
+                     "assembled in parts needs the blocks (set_blocks): a part's diagonal does not show the pressures");
     split_ = saddle_point_split(A, blocks_ ? &*blocks_ : nullptr, name);
     sys_.analyze(A);
     make_splits();
   }
 
   void factorize(const SparseMatrix& A) {
+    if (sys_.summed()) analyzed_ = detail::PetscSystem::all(analyzed_);  // every rank takes the same path
     if (!analyzed_) {
       analyze(A);
       sys_.set_values(A);
@@ -606,27 +635,18 @@ class PetscKrylov {
     sys_.setup();
   }
   VecX solve(const VecX& b) { return sys_.solve(b); }
-  /// Assembly in parts (la/partition.hpp): with `set_summed(true)` on more than one rank, each
-  /// rank passes the matrix of its cells and the solve is with their sum (PetscSystem::set_summed).
-  void set_summed(bool summed) { sys_.set_summed(summed); analyzed_ = analyzed_ && sys_.summed() == summed; }
-  int parts() const { return PetscSession::size(); }
-  int part() const { return PetscSession::rank(); }
-  /// The rank of each cell when assembling in parts (detail::petsc_partition: PT-Scotch).
-  template <int Dim>
-  std::vector<int> partition(const Mesh<Dim>& mesh) const {
-    return detail::petsc_partition(mesh);
+  /// Assembly in parts (PetscPolicy): a change of the setting analyses afresh.
+  void set_summed(bool summed) {
+    const bool was = sys_.summed();
+    sys_.set_summed(summed);
+    if (sys_.summed() != was) analyzed_ = false;
   }
-  void sum(VecX& v) const { detail::PetscSystem::sum(v); }
-  void min(std::vector<int>& w) const { detail::PetscSystem::min(w); }
 
   int iterations() const { return sys_.iterations(); }
   Index n_pressure() const { return split_.n_pressure; }
   Index n_extra() const { return split_.n_extra; }
   /// Whether the Schur complement is preconditioned by the pressure mass matrix (else selfp).
   bool pressure_mass() const { return use_mass_; }
-  Index row_begin() const { return sys_.row_begin(); }
-  Index row_end() const { return sys_.row_end(); }
-  KSP ksp() const { return sys_.ksp(); }
 
  private:
   // The splits' index sets: this rank's rows of split 0 (velocities [0, nu) and bodies
@@ -690,9 +710,7 @@ class PetscKrylov {
     ALEFSI_PETSC(KSPSetFromOptions(ksp));
     configured_ = true;
   }
-  // S~ = -C - M_p / mu (PETSc's Schur complement is A_pp - B A^-1 B^T, negative: A_pp = -C),
-  // this rank's pressure rows, in the numbering of split 1 (PETSc numbers a split's unknowns in
-  // rank order: this rank's pressures are contiguous there).
+  // Whether the Schur complement is preconditioned by the pressure mass (steady Stokes).
   bool mass_path(const SaddlePointBlocks& b) const {
     return b.mass_coefficient == 0 && b.pressure_mass.rows() == b.n_pressure && b.n_pressure > 0;
   }
@@ -754,7 +772,6 @@ class PetscKrylov {
   }
 
   PetscKrylovOptions opt_;
-  detail::PetscSystem sys_;
   std::optional<SaddlePointBlocks> blocks_;
   SaddlePointSplit split_;
   IS is0_ = nullptr, is1_ = nullptr;

@@ -346,8 +346,12 @@ class AleFlow {
     s.X[0] = mesh_.coordinates();
     state_ = std::move(s);
     setup();
-    if (!flow_factors.factored.empty()) disc_.assembler().take_pattern(disc_.jacobian());
-    restore_factors(file, "flow", flow_factors, disc_.jacobian(), disc_.linear_solve());
+    // in parts (MPI) the flow's factors are not reused, and a whole matrix's kept factors would
+    // not fit a part's pattern: the first solve factorises afresh
+    if (!disc_.in_parts()) {
+      if (!flow_factors.factored.empty()) disc_.assembler().take_pattern(disc_.jacobian());
+      restore_factors(file, "flow", flow_factors, disc_.jacobian(), disc_.linear_solve());
+    }
     restore_factors(file, "mesh-velocity", motion_factors, disc_.motion().matrix(), disc_.motion().linear_solve());
   }
 

@@ -24,7 +24,7 @@
 ///
 ///     Discretisation<Cfg> disc(mesh, options);            // or (mesh, options, solver options)
 ///     disc.constrain(dirichlet, bodies);
-///     disc.assembler().assemble(disc.kernel(), field, &disc.jacobian(), &r);
+///     disc.assemble(field, &disc.jacobian(), &r);  // (in parts: this process's cells)
 #include <map>
 #include <memory>
 #include <utility>
@@ -234,10 +234,10 @@ class Discretisation {
   Real gamma_ = -1;
   VecX hist_, ustar_;  // the step's kernel inputs
   const QuadraticGeometry<D>* geometry_ = nullptr;
-  std::vector<Vec<D>> edge_velocity_;
+  std::vector<Vec<D>> edge_velocity_;  // the step's edge-point velocities (curved geometry)
   bool in_parts_ = false;
   std::vector<Index> own_cells_;  // in parts: this process's cells
-  std::vector<char> touched_;     // in parts: the unknowns its cells touch  // the step's edge-point velocities (curved geometry)
+  std::vector<char> touched_;     // in parts: the unknowns its cells touch
 };
 
 }  // namespace alefsi

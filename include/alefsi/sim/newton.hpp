@@ -52,7 +52,10 @@ struct NewtonOptions {
   Real scaled_tolerance = 1e-14;  ///< on max_i |r_i| / (sum_j |J_ij| max|u|)
   Real step_tolerance = 1e-12;   ///< on max|du| / max|u|
   /// With J assembled in parts (one per MPI process, la/partition.hpp): sums a vector over the
-  /// processes (the row sums of the scaled-residual test). Empty: J is whole.
+  /// processes (the row sums of the scaled-residual test). Empty: J is whole. The parts' row
+  /// sums of |J_ij| bound the whole matrix's from above (an entry split over two parts may
+  /// cancel in the sum), so the scaled residual is at most the whole matrix's and the test may
+  /// stop a Newton iteration sooner than a serial run (the residual test is unchanged).
   std::function<void(VecX&)> sum_parts{};
 };
 

@@ -435,12 +435,11 @@ TEST_CASE("Navier-Stokes kernel: the element matrix is the derivative of the ele
   }
 }
 
-TEST_CASE("assembly with partly fixed nodes and a 6-unknown link equals the dense T^T A T", "[la][assembly][quick]") {
-  // component 0 fixed on the outer circle (component 1 free: blocks of one), the inner circle
-  // linked to 6 extra unknowns (a block of 6: the generic scatter path), pressure free
-  const auto mesh = annulus_mesh(0.3, 1.0, 4, 20);
-  using Space = MixedSpace<2, TaylorHood>;
-  Space space(mesh);
+namespace {
+// The annulus's constraints for the assembly tests: component 0 fixed on the outer circle
+// (component 1 free: blocks of one), the inner circle linked to 6 extra unknowns (a block of 6:
+// the generic scatter path), pressure free; finalized.
+DofConstraints fixed_and_linked(const MixedSpace<2, TaylorHood>& space) {
   DofConstraints cons(space.n_field());
   const Index z = cons.add_unknowns(6);
   for (Index i : space.velocity().boundary_dofs(tags::outer)) cons.fix(space.velocity_field(i, 0), 0.3);
@@ -453,6 +452,17 @@ TEST_CASE("assembly with partly fixed nodes and a 6-unknown link equals the dens
     cons.link(space.velocity_field(i, 1), ex, w1, -0.02);
   }
   cons.finalize();
+  return cons;
+}
+
+}  // namespace
+
+TEST_CASE("assembly with partly fixed nodes and a 6-unknown link equals the dense T^T A T", "[la][assembly][quick]") {
+  // fixed_and_linked: a fixed component, and a 6-unknown link on the inner circle
+  const auto mesh = annulus_mesh(0.3, 1.0, 4, 20);
+  using Space = MixedSpace<2, TaylorHood>;
+  Space space(mesh);
+  const DofConstraints cons = fixed_and_linked(space);
   Assembler<Space::n_local> asmb(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
   VecX field(space.n_field());
   for (Index f = 0; f < field.size(); ++f) field[f] = std::sin(1.3 * f);
@@ -932,18 +942,7 @@ TEST_CASE("cells in Morton parts: balanced, a cube cut on its mid-plane, and the
   const auto mesh = annulus_mesh(0.3, 1.0, 4, 20);
   using Space = MixedSpace<2, TaylorHood>;
   Space space(mesh);
-  DofConstraints cons(space.n_field());
-  const Index z = cons.add_unknowns(6);
-  for (Index i : space.velocity().boundary_dofs(tags::outer)) cons.fix(space.velocity_field(i, 0), 0.3);
-  for (Index i : space.velocity().boundary_dofs(tags::inner)) {
-    const Vec<2> x = space.velocity().point(i);
-    const Index ex[] = {z, z + 1, z + 2, z + 3, z + 4, z + 5};
-    const Real w0[] = {1.0, 0.0, -x[1], x[0] * x[0], 0.5, -x[0] * x[1]};
-    const Real w1[] = {0.0, 1.0, x[0], 0.2, x[1] * x[1], x[0]};
-    cons.link(space.velocity_field(i, 0), ex, w0, 0.01);
-    cons.link(space.velocity_field(i, 1), ex, w1, -0.02);
-  }
-  cons.finalize();
+  const DofConstraints cons = fixed_and_linked(space);
   VecX field(space.n_field());
   for (Index f = 0; f < field.size(); ++f) field[f] = std::sin(1.3 * f);
   PseudoRandomKernel<Space::n_local> k;

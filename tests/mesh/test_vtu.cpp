@@ -2,7 +2,9 @@
 // (tests/mesh/vtu_check.py, run with the python named by ALEFSI_PYTHON_VTK).
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -649,4 +651,183 @@ TEST_CASE("PvdWriter: time series", "[mesh][vtu]") {
     }
   }
   CHECK(rb.grids[1].types[0] == 22);
+}
+
+// ------------------------------------------------------------------ pieces (MPI output)
+namespace {
+
+/// The cells of part k when cell c goes to part c % parts (scattered parts: most points of a
+/// piece lie on its border).
+std::vector<Index> cells_mod(Index n_cells, int parts, int k) {
+  std::vector<Index> cells;
+  for (Index c = k; c < n_cells; c += parts) cells.push_back(c);
+  return cells;
+}
+
+/// The joined grid of the pieces (cells part after part) shows every cell as the whole file
+/// shows it: the same points, point data at each of its points, cell data and VTK's probe.
+void check_joined(const VtkGrid& joined, const VtkGrid& whole, const std::vector<std::vector<Index>>& parts) {
+  std::vector<Index> order;  // whole-mesh cell of each joined cell
+  for (const auto& p : parts) order.insert(order.end(), p.begin(), p.end());
+  REQUIRE(joined.n_cells == long(order.size()));
+  REQUIRE(joined.n_cells == whole.n_cells);
+  REQUIRE(joined.point_data.size() == whole.point_data.size());
+  REQUIRE(joined.cell_data.size() == whole.cell_data.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const std::size_t c = std::size_t(order[k]);
+    INFO("joined cell " << k << " = cell " << c);
+    REQUIRE(joined.types[k] == whole.types[c]);
+    REQUIRE(joined.cells[k].size() == whole.cells[c].size());
+    for (std::size_t v = 0; v < whole.cells[c].size(); ++v) {
+      const auto pj = std::size_t(joined.cells[k][v]), pw = std::size_t(whole.cells[c][v]);
+      REQUIRE(joined.points[pj] == whole.points[pw]);  // bit for bit: the same doubles
+      for (std::size_t a = 0; a < whole.point_data.size(); ++a) {
+        const VtkArray &aj = joined.point_data[a].second, &aw = whole.point_data[a].second;
+        REQUIRE(joined.point_data[a].first == whole.point_data[a].first);
+        for (int i = 0; i < aw.components; ++i)
+          REQUIRE(aj.values[pj * std::size_t(aj.components) + std::size_t(i)] ==
+                  aw.values[pw * std::size_t(aw.components) + std::size_t(i)]);
+      }
+    }
+    for (std::size_t a = 0; a < whole.cell_data.size(); ++a) {
+      const VtkArray &aj = joined.cell_data[a].second, &aw = whole.cell_data[a].second;
+      REQUIRE(joined.cell_data[a].first == whole.cell_data[a].first);
+      for (int i = 0; i < aw.components; ++i) {
+        const Real vj = aj.values[k * std::size_t(aj.components) + std::size_t(i)];
+        const Real vw = aw.values[c * std::size_t(aw.components) + std::size_t(i)];
+        REQUIRE((vj == vw || (std::isnan(vj) && std::isnan(vw))));
+      }
+    }
+    REQUIRE(joined.probes[k] == whole.probes[c]);
+  }
+}
+
+/// Points a piece of `cells` must hold: the nodes (and for order 2 the edges) of its cells.
+template <int D>
+long used_points(const Mesh<D>& m, const std::vector<Index>& cells, int order) {
+  std::vector<char> used(std::size_t(m.n_nodes() + m.n_edges()), 0);
+  for (Index c : cells) {
+    for (Index v : m.cell(c)) used[std::size_t(v)] = 1;
+    if (order == 2)
+      for (Index e : m.cell_edges(c)) used[std::size_t(m.n_nodes() + e)] = 1;
+  }
+  return long(std::count(used.begin(), used.end(), 1));
+}
+
+template <int D>
+void check_pieces(const Case<D>& c, int parts, const fs::path& dir) {
+  const Mesh<D>& m = *c.mesh;
+  std::vector<std::vector<Index>> cells;
+  std::vector<std::string> sources;
+  std::vector<fs::path> files{c.file};
+  for (int k = 0; k < parts; ++k) {
+    cells.push_back(cells_mod(m.n_cells(), parts, k));
+    sources.push_back(c.file.stem().string() + "_p" + std::to_string(k) + ".vtu");
+    write_vtu_piece<D>(dir / sources.back(), m, cells.back(), c.fields(), c.order, c.curved);
+    files.push_back(dir / sources.back());
+  }
+  const fs::path pvtu = dir / (c.file.stem().string() + ".pvtu");
+  write_pvtu<D>(pvtu, m, c.fields(), sources, c.order);
+  files.push_back(pvtu);
+  c.write();
+  const VtkReadback rb = read_with_vtk(files, dir);
+  REQUIRE(rb.grids.size() == std::size_t(parts) + 2);
+  const VtkGrid& whole = rb.grids.front();
+  c.check(whole);  // the whole file as the round-trip test checks it
+  for (int k = 0; k < parts; ++k) {
+    INFO("piece " << k);
+    CHECK(rb.grids[std::size_t(k) + 1].n_cells == long(cells[std::size_t(k)].size()));
+    CHECK(rb.grids[std::size_t(k) + 1].n_points == used_points(m, cells[std::size_t(k)], c.order));
+  }
+  check_joined(rb.grids.back(), whole, cells);
+}
+
+}  // namespace
+
+TEST_CASE("write_vtu_piece + write_pvtu: the pieces joined by VTK's parallel reader are the whole mesh", "[mesh][vtu]") {
+  TempDir tmp;
+  const Mesh<2> m2 = tagged_square();
+  const Mesh<3> m3 = tagged_box();
+  check_pieces(Case<2>{m2, 1, tmp.path / "tri1.vtu", false}, 3, tmp.path);
+  check_pieces(Case<2>{m2, 2, tmp.path / "tri2_curved.vtu", true}, 2, tmp.path);
+  check_pieces(Case<3>{m3, 1, tmp.path / "tet1.vtu", false}, 3, tmp.path);
+  check_pieces(Case<3>{m3, 2, tmp.path / "tet2.vtu", false}, 4, tmp.path);
+}
+
+TEST_CASE("write_vtu_piece, write_pvtu: bad input throws InvalidArgument before anything is written", "[mesh][vtu]") {
+  TempDir tmp;
+  const Mesh<2> m = tagged_square();
+  std::vector<Real> p(std::size_t(m.n_nodes()), 1.0);
+  const std::vector<VtuField> f{{"p", 1, p}};
+  const fs::path file = tmp.path / "x.vtu";
+  const std::vector<Index> unsorted{3, 2}, repeated{1, 1}, outside{0, m.n_cells()}, negative{-1};
+  for (const auto* cells : {&unsorted, &repeated, &outside, &negative})
+    CHECK_THROWS_AS(write_vtu_piece<2>(file, m, *cells, f), InvalidArgument);
+  CHECK_THROWS_AS(write_vtu_piece<2>(file, m, std::vector<Index>{0}, {{{"p", 2, p}}}), InvalidArgument);
+  CHECK_THROWS_AS(write_pvtu<2>(tmp.path / "x.pvtu", m, f, std::vector<std::string>{}), InvalidArgument);
+  CHECK_THROWS_AS(write_pvtu<2>(tmp.path / "x.pvtu", m, f, std::vector<std::string>{"a.vtu", ""}), InvalidArgument);
+  CHECK(listing(tmp.path).empty());
+}
+
+TEST_CASE("PvdWriter: a series of pieces, and a failed piece on one process", "[mesh][vtu]") {
+  TempDir tmp;
+  const Mesh<3> m = tagged_box();
+  const int parts = 3;
+  const fs::path pvd = tmp.path / "run.pvd";
+  // the processes of a parallel run, played one after the other (part 0 last: it writes the
+  // .pvtu and the collection); `agree` plays the collective
+  std::vector<std::unique_ptr<PvdWriter>> writers;
+  for (int k = 0; k < parts; ++k) writers.push_back(std::make_unique<PvdWriter>(pvd));
+  std::vector<std::vector<Index>> cells;
+  for (int k = 0; k < parts; ++k) cells.push_back(cells_mod(m.n_cells(), parts, k));
+  bool agree = true;
+  auto step = [&](Real t, const std::vector<Real>& u, int k) {
+    return writers[std::size_t(k)]->write(t, m, {{"u", 1, u}},
+                                          VtuPiece{cells[std::size_t(k)], k, parts, [&](bool ok) { return ok && agree; }});
+  };
+  std::vector<std::vector<Real>> values;
+  for (Real t : {0.0, 0.5}) {
+    std::vector<Real> u;
+    for (const auto& x : m.coordinates()) u.push_back(f_lin(to3<3>(x)) + t);
+    values.push_back(std::move(u));
+  }
+  for (int s = 0; s < 2; ++s)
+    for (int k = parts - 1; k >= 0; --k) {
+      const fs::path pvtu = step(0.5 * s, values[std::size_t(s)], k);
+      CHECK(pvtu == tmp.path / "run" / ("run_00000" + std::to_string(s) + ".pvtu"));
+      CHECK(writers[std::size_t(k)]->steps() == std::size_t(s) + 1);
+    }
+  CHECK(listing(tmp.path) ==
+        std::vector<std::string>{"run", "run.pvd", "run/run_000000.pvtu", "run/run_000000_p0000.vtu",
+                                 "run/run_000000_p0001.vtu", "run/run_000000_p0002.vtu", "run/run_000001.pvtu",
+                                 "run/run_000001_p0000.vtu", "run/run_000001_p0001.vtu", "run/run_000001_p0002.vtu"});
+  const std::string listed = slurp(pvd);
+  // another process fails: IoError here, and nothing listed
+  agree = false;
+  CHECK_THROWS_AS(step(1.0, values[0], 0), IoError);
+  // this process's own piece fails (cells out of range): its own error, rethrown after the agreement
+  std::vector<Index> bad{m.n_cells()};
+  bool asked = false;
+  CHECK_THROWS_AS(writers[1]->write(1.0, m, {{"u", 1, values[0]}}, VtuPiece{bad, 1, parts, [&](bool ok) {
+                                      asked = true;
+                                      return ok;
+                                    }}),
+                  InvalidArgument);
+  CHECK(asked);  // it reached the collective call before throwing
+  for (const auto& w : writers) CHECK(w->steps() == 2);
+  CHECK(slurp(pvd) == listed);
+
+  const VtkReadback rb = read_with_vtk({pvd}, tmp.path);
+  REQUIRE(rb.pvds.size() == 1);
+  REQUIRE(rb.pvds[0].steps.size() == 2);
+  CHECK(rb.pvds[0].steps[1].second == "run/run_000001.pvtu");
+  REQUIRE(rb.grids.size() == 2);
+  for (std::size_t s = 0; s < 2; ++s) {
+    const VtkGrid& g = rb.grids[s];
+    REQUIRE(g.n_cells == m.n_cells());
+    const auto* u = g.find(g.point_data, "u");
+    REQUIRE(u);
+    for (std::size_t p = 0; p < std::size_t(g.n_points); ++p)
+      REQUIRE(u->values[p] == Approx(f_lin(g.points[p]) + 0.5 * Real(s)).margin(1e-13));
+  }
 }

@@ -1,6 +1,9 @@
 """Reads .vtu / .pvd files with VTK's own XML reader and dumps what VTK sees, for test_vtu.cpp.
 
-Usage: vtu_check.py FILE...   (FILE ends in .vtu or .pvd)
+Usage: vtu_check.py FILE...   (FILE ends in .vtu, .pvtu or .pvd)
+
+A .pvtu is read by VTK's parallel reader, which joins its pieces into one grid (cells piece
+after piece; a point shared by pieces appears once per piece).
 
 Output (stdout): whitespace-separated tokens, one record per line; strings (paths, array
 names) are hex-encoded UTF-8 so they never contain whitespace; numbers use Python's repr
@@ -52,10 +55,11 @@ def read_grid(path, out):
         fail("no such file: " + path)
     log_window = vtk.vtkStringOutputWindow()  # collects VTK's errors and warnings for this file
     vtk.vtkOutputWindow.SetInstance(log_window)
-    reader = vtk.vtkXMLUnstructuredGridReader()
+    parallel = path.endswith(".pvtu")
+    reader = vtk.vtkXMLPUnstructuredGridReader() if parallel else vtk.vtkXMLUnstructuredGridReader()
     reader.SetFileName(path)
     if not reader.CanReadFile(path):
-        fail("vtkXMLUnstructuredGridReader cannot read " + path)
+        fail(reader.GetClassName() + " cannot read " + path)
     reader.Update()
     log = log_window.GetOutput()
     if log.strip():

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <iostream>
 #include <numbers>
 #include <string>
@@ -302,7 +303,7 @@ TEST_CASE("AleFlow with PetscKrylov<3> or PetscDirect: 3D Navier–Stokes steps 
 }
 
 TEST_CASE("a sphere settling in a spherical container: 10 steps through run() on N ranks follow the serial "
-          "trajectory, rank 0 writes, and its checkpoint continues in a serial flow",
+          "trajectory, rank 0 writes, each rank its VTU piece, and the checkpoint continues in a serial flow",
           "[petsc][settling][quick]") {
   // examples/sphere_settling.cpp's scene: Navier–Stokes, a free sphere under gravity, the mesh
   // moved by elasticity. Every rank runs the PETSc flow through the driver (rank 0 writing into
@@ -331,8 +332,54 @@ TEST_CASE("a sphere settling in a spherical container: 10 steps through run() on
   scene.configure(distributed);
   RunOptions opt;
   opt.t_end = steps * dt, opt.output = dir, opt.checkpoint_every = steps / 2, opt.writer = PetscSession::rank() == 0;
+  opt.vtu_every = steps / 2;
   const auto [x_mpi, v_mpi] = trajectory(distributed, opt);
   MPI_Barrier(PETSC_COMM_WORLD);  // rank 0's files are complete
+
+  // the VTU series: steps 0, 5, 10; in parts, one piece per rank holding its cells and the
+  // .pvtu that joins them (the pieces' contents are checked by VTK in tests/mesh/test_vtu.cpp)
+  {
+    const int ranks = PetscSession::size();
+    CHECK(distributed.in_parts() == (ranks > 1));
+    auto text = [](const std::filesystem::path& f) {
+      std::ifstream in(f, std::ios::binary);
+      std::ostringstream s;
+      s << in.rdbuf();
+      return s.str();
+    };
+    auto count = [](const std::string& s, const std::string& what) {
+      int n = 0;
+      for (auto at = s.find(what); at != std::string::npos; at = s.find(what, at + 1)) ++n;
+      return n;
+    };
+    const std::string pvd = text(dir / "flow.pvd");
+    CHECK(count(pvd, "<DataSet ") == 3);
+    for (int k = 0; k < 3; ++k) {
+      const std::string step = "flow_00000" + std::to_string(k);
+      if (ranks == 1) {
+        CHECK(std::filesystem::is_regular_file(dir / "flow" / (step + ".vtu")));
+        continue;
+      }
+      CHECK(count(pvd, "file=\"flow/" + step + ".pvtu\"") == 1);
+      CHECK(count(text(dir / "flow" / (step + ".pvtu")), "<Piece Source=") == ranks);
+      long cells = 0;  // the pieces' cells: every cell once
+      for (int r = 0; r < ranks; ++r) {
+        const std::string head = text(dir / "flow" / (step + "_p000" + std::to_string(r) + ".vtu")).substr(0, 400);
+        const auto at = head.find("NumberOfCells=\"");
+        REQUIRE(at != std::string::npos);
+        cells += std::stol(head.substr(at + 15));
+      }
+      CHECK(cells == distributed.mesh().n_cells());
+    }
+    CHECK(long(distributed.own_cells().size()) == (ranks > 1 ? long(distributed.assembled_cells()) : 0L));
+    // processes that disagree on the pieces are refused on every process, before any step
+    if (ranks > 1) {
+      RunOptions odd = opt;
+      odd.t_end = 2 * steps * dt, odd.vtu_every = PetscSession::rank() == 1 ? 0 : 1, odd.log = nullptr;
+      CHECK_THROWS_AS(run(distributed, odd), InvalidArgument);
+      CHECK(distributed.time() == Approx(steps * dt));
+    }
+  }
 
   AleFlow<Cfg::with_solver<SaddlePointGmres<3>>> serial(scene.mesh(), scene.flow_options());
   scene.configure(serial);

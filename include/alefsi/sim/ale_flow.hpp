@@ -139,6 +139,21 @@ class AleFlow {
   /// The cells whose matrix this process assembles: all, or its part under MPI with a solver
   /// that sums the parts (sim/discretisation.hpp).
   Index assembled_cells() const { return disc_.assembled_cells(); }
+  /// Whether each process assembles a part of the cells (MPI; sim/discretisation.hpp), and then
+  /// its part, the number of parts and its cells (increasing), e.g. for output in pieces.
+  bool in_parts() const { return disc_.in_parts(); }
+  int part() const { return disc_.part(); }
+  int parts() const { return disc_.parts(); }
+  const std::vector<Index>& own_cells() const { return disc_.own_cells(); }
+  /// Whether `ok` holds on every process: a collective call in parts (every process must make
+  /// it), `ok` itself otherwise.
+  bool all_parts(bool ok) const {
+    std::vector<int> w{ok ? 1 : 0};
+    disc_.min_parts(w);
+    return w[0] == 1;
+  }
+  /// The elementwise minimum of w over the processes: a collective call in parts, nothing otherwise.
+  void min_parts(std::vector<int>& w) const { disc_.min_parts(w); }
   /// Smallest Mesh::quality over the cells.
   Real worst_quality() const { return alefsi::worst_quality(mesh_); }
 

@@ -156,6 +156,8 @@ class Discretisation {
     if constexpr (SummedPartsSolver<Solver>)
       if (in_parts_) solve_.solver().min(w);
   }
+  /// In parts: this process's cells, increasing (empty otherwise).
+  const std::vector<Index>& own_cells() const { return own_cells_; }
   /// Cells this process assembles.
   Index assembled_cells() const { return in_parts_ ? Index(own_cells_.size()) : space_->mesh().n_cells(); }
   /// Whether this process's cells touch unknown u (always, unless in parts).

@@ -45,7 +45,11 @@
 ///    dropping rows later than the restart time, and starts a new PVD series
 ///    `flow_from_<step>.pvd`.
 ///  * a progress line every `progress_every` steps (and at the end) on `log`.
-///  * under MPI: only the process with `writer` set writes files and lines (rank 0).
+///  * under MPI: only the process with `writer` set (rank 0) writes the CSV, the checkpoints and
+///    the log. When the processes assemble parts of the cells (AleFlow::in_parts), each writes
+///    its cells' VTU piece `<output>/flow/flow_NNNNNN_pPPPP.vtu` and part 0 writes the step's
+///    `.pvtu` and the PVD that lists it (PvdWriter with a VtuPiece): the pieces need the same
+///    `output` and `vtu_every` on every process and a folder they all see.
 ///
 ///     alefsi::RunOptions opt{.dt = 1e-3, .t_end = 0.5, .output = "out", .vtu_every = 50};
 ///     alefsi::RunSummary s = alefsi::run(flow, opt);
@@ -102,8 +106,8 @@ struct RunOptions {
   std::ostream* log = &std::cout;   ///< progress and remarks; nullptr: silent
   /// Whether this process writes the files and the log. Under MPI with the shared-mesh model
   /// (la/petsc.hpp) every rank holds the whole state: rank 0 writes (`PetscSession::rank() ==
-  /// 0`), the others step in lockstep and write nothing. A checkpoint is then the same on any
-  /// number of ranks and restarts on any other.
+  /// 0`), the others step in lockstep and write only their VTU pieces (file comment). A
+  /// checkpoint is then the same on any number of ranks and restarts on any other.
   bool writer = true;
   /// Called after every accepted step (e.g. extra monitoring); may throw to stop the run.
   std::function<void()> on_step = {};
@@ -222,6 +226,17 @@ RunSummary run(Flow& flow, const RunOptions& options) {
   flow.prepare();  // a scene that cannot run is refused before anything is written
   ALEFSI_CHECK_ARG(options.checkpoint_every == 0 || options.output.empty() || !flow.geometry(), "checkpoint_every",
                    "flows with curved boundaries cannot be checkpointed yet: set it to 0");
+  // in parts every process writes its VTU piece, at the same steps (a collective check)
+  bool pieces = false;
+  if (flow.in_parts()) {
+    const int every = options.output.empty() ? 0 : options.vtu_every;
+    std::vector<int> w{every, -every};
+    flow.min_parts(w);
+    ALEFSI_CHECK_ARG(w[0] == -w[1], "vtu_every",
+                     "in parts every process writes its VTU piece at the same steps: give every process the same "
+                     "output folder and vtu_every (they range from ", w[0], " to ", -w[1], ")");
+    pieces = every > 0;
+  }
   RunOptions opt = options;  // (every check above is made on every rank: they all stop together)
   if (!opt.writer) opt.output.clear(), opt.log = nullptr;
   const auto wall0 = std::chrono::steady_clock::now();
@@ -245,17 +260,22 @@ RunSummary run(Flow& flow, const RunOptions& options) {
       for (std::size_t k = 0; k < nb; ++k) detail::body_csv_header<typename Flow::BodyModel>(csv, k);
       csv << '\n';
     }
-    if (opt.vtu_every > 0) {
-      const std::string name =
-          t_start > 0 ? "flow_from_" + std::to_string(flow.stats().steps) + ".pvd" : std::string("flow.pvd");
-      pvd = std::make_unique<PvdWriter>(opt.output / name);
-    }
+  }
+  const std::filesystem::path vtu_output = pieces ? options.output : opt.output;  // pieces: every process
+  if (!vtu_output.empty() && opt.vtu_every > 0) {
+    std::filesystem::create_directories(vtu_output);
+    const std::string name =
+        t_start > 0 ? "flow_from_" + std::to_string(flow.stats().steps) + ".pvd" : std::string("flow.pvd");
+    pvd = std::make_unique<PvdWriter>(vtu_output / name);
   }
   std::vector<Real> u, p, w;
   auto write_vtu_now = [&] {
     detail::nodal_fields(flow, u, p, w);
     constexpr int D = Flow::Space::dim;
-    pvd->write(flow.time(), flow.mesh(), std::vector<VtuField>{{"velocity", D, u}, {"pressure", 1, p}, {"mesh_velocity", D, w}});
+    const std::vector<VtuField> fields{{"velocity", D, u}, {"pressure", 1, p}, {"mesh_velocity", D, w}};
+    if (!pieces) return void(pvd->write(flow.time(), flow.mesh(), fields));
+    pvd->write(flow.time(), flow.mesh(), fields,
+               VtuPiece{flow.own_cells(), flow.part(), flow.parts(), [&](bool ok) { return flow.all_parts(ok); }});
   };
   if (pvd && t_start == 0) write_vtu_now();
 

@@ -1,6 +1,7 @@
 #pragma once
 /// \file mesh/io/vtu.hpp
-/// VTK XML unstructured-grid (.vtu) and time-series collection (.pvd) writers, for ParaView.
+/// VTK XML unstructured-grid (.vtu), parallel (.pvtu) and time-series collection (.pvd) writers,
+/// for ParaView.
 ///
 /// What is written (VTK >= 6 / ParaView readable; checked against VTK 9's reader):
 ///   * `<VTKFile type="UnstructuredGrid" version="1.0" header_type="UInt64">`, byte order of the
@@ -34,7 +35,14 @@
 /// than "region" (reserved for the cell tags), components >= 1, and a value count matching its
 /// location as above. Names may contain any character (XML-escaped in the file).
 ///
-/// Atomicity: every file (.vtu and .pvd) is written to a hidden temporary in the target's
+/// Pieces (MPI output, each process writing its cells): `write_vtu_piece` writes a subset of
+/// the cells with the points they use (renumbered in the mesh's order, so a point on the border
+/// of two pieces is in both), the same arrays as the whole file; `write_pvtu` writes the
+/// `<VTKFile type="PUnstructuredGrid">` file naming the arrays and the pieces, which VTK's
+/// parallel reader joins into one grid; `PvdWriter::write` with a `VtuPiece` runs a series of
+/// them, with the processes agreeing after each file (a failure anywhere throws everywhere).
+///
+/// Atomicity: every file (.vtu, .pvtu and .pvd) is written to a hidden temporary in the target's
 /// directory (".<name>.tmp-<random>", created exclusively), flushed and closed, then renamed over
 /// the target. On any failure the temporary is removed and `IoError` (naming the target and the
 /// reason) is thrown; the target is then untouched, old content or absent, never half-written.
@@ -53,6 +61,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <functional>
 #include <initializer_list>
@@ -247,7 +256,47 @@ void check_vtu_input(const Mesh<D>& mesh, std::span<const VtuField> fields, int 
   }
 }
 
-/// One array of the appended block: its XML description and a function writing its bytes.
+/// The cells a file holds and the points they use: the whole mesh, or a piece (its cells in
+/// increasing order; its points are the nodes and, for order 2, the edges of those cells, in
+/// the mesh's point order: nodes, then n_nodes() + edge).
+struct VtuSelection {
+  bool whole = true;
+  std::vector<Index> cells, points;  // a piece's; empty for the whole mesh
+  std::vector<Index> local;          // a piece's: mesh point -> its point in the piece (-1: unused)
+
+  template <int D>
+  std::size_t n_points(const Mesh<D>& mesh, int order) const {
+    return whole ? std::size_t(mesh.n_nodes() + (order == 2 ? mesh.n_edges() : 0)) : points.size();
+  }
+  template <int D>
+  std::size_t n_cells(const Mesh<D>& mesh) const {
+    return whole ? std::size_t(mesh.n_cells()) : cells.size();
+  }
+};
+
+template <int D>
+VtuSelection select_cells(const Mesh<D>& mesh, std::span<const Index> cells, int order) {
+  const Index nn = mesh.n_nodes(), np = order == 2 ? nn + mesh.n_edges() : nn;
+  for (std::size_t i = 0; i < cells.size(); ++i)
+    ALEFSI_CHECK_ARG(cells[i] >= 0 && cells[i] < mesh.n_cells() && (i == 0 || cells[i] > cells[i - 1]), "cells",
+                     "must be increasing cell indices of the mesh (", mesh.n_cells(), " cells); cells[", i, "] = ",
+                     cells[i], i > 0 ? concat(" after ", cells[i - 1]) : std::string());
+  VtuSelection s;
+  s.whole = false;
+  s.cells.assign(cells.begin(), cells.end());
+  std::vector<char> used(std::size_t(np), 0);
+  for (Index c : cells) {
+    for (Index v : mesh.cell(c)) used[std::size_t(v)] = 1;
+    if (order == 2)
+      for (Index e : mesh.cell_edges(c)) used[std::size_t(nn + e)] = 1;
+  }
+  s.local.assign(std::size_t(np), -1);
+  for (Index g = 0; g < np; ++g)
+    if (used[std::size_t(g)]) s.local[std::size_t(g)] = Index(s.points.size()), s.points.push_back(g);
+  return s;
+}
+
+/// One array of a file: its XML description and a function writing its bytes.
 struct VtuArray {
   int section;  // 0 PointData, 1 CellData, 2 Points, 3 Cells
   const char* type;
@@ -257,14 +306,19 @@ struct VtuArray {
   std::function<void(AtomicFile&)> emit;
 };
 
+inline constexpr std::array<const char*, 4> vtu_sections{"PointData", "CellData", "Points", "Cells"};
+
+/// The arrays of a file of `mesh`'s selected cells, in the order they are written.
 template <int D>
-void write_vtu_to(AtomicFile& out, const Mesh<D>& mesh, std::span<const VtuField> fields, int order,
-                  std::span<const Vec<D>> edge_midpoints) {
-  const std::size_t nn = std::size_t(mesh.n_nodes()), ne = std::size_t(mesh.n_edges()),
-                    nc = std::size_t(mesh.n_cells());
-  const std::size_t np = order == 2 ? nn + ne : nn;
+std::vector<VtuArray> vtu_arrays(const Mesh<D>& mesh, std::span<const VtuField> fields, int order,
+                                 std::span<const Vec<D>> edge_midpoints, const VtuSelection& sel) {
+  const std::size_t nn = std::size_t(mesh.n_nodes()), ne = std::size_t(mesh.n_edges());
+  const std::size_t np = sel.n_points(mesh, order), nc = sel.n_cells(mesh);
   const int npc = order == 2 ? D + 1 + simplex_edges<D> : D + 1;
   const std::uint8_t cell_type = D == 2 ? (order == 2 ? 22 : 5) : (order == 2 ? 24 : 10);
+  // the mesh point of point i and the mesh cell of cell k in the file
+  auto point = [&sel](std::size_t i) { return sel.whole ? i : std::size_t(sel.points[i]); };
+  auto cell = [&sel](std::size_t k) { return sel.whole ? Index(k) : sel.cells[k]; };
 
   std::vector<VtuArray> arrays;
   // --- point data
@@ -274,72 +328,76 @@ void write_vtu_to(AtomicFile& out, const Mesh<D>& mesh, std::span<const VtuField
     const std::size_t cw = std::size_t(vtk_components<D>(f.components));
     const bool p2 = f.values.size() == c * (nn + ne);
     const std::span<const Real> v = f.values;
-    arrays.push_back({0, "Float64", f.name, int(cw), 8 * cw * np, [=, &mesh](AtomicFile& o) {
-                        auto tuples = [&](std::size_t first, std::size_t count) {
-                          if (cw == c) return o.write(v.data() + first * c, count * c * sizeof(Real));
-                          for (std::size_t i = first; i < first + count; ++i) {
-                            for (std::size_t k = 0; k < c; ++k) o.put(v[i * c + k]);
-                            for (std::size_t k = c; k < cw; ++k) o.put(Real(0));
+    arrays.push_back({0, "Float64", f.name, int(cw), 8 * cw * np, [=, &mesh, &sel](AtomicFile& o) {
+                        // the whole mesh's tuples lie in order in v, unless padded or interpolated
+                        if (sel.whole && cw == c && (order == 1 || p2)) return o.write(v.data(), np * c * sizeof(Real));
+                        for (std::size_t i = 0; i < np; ++i) {
+                          const std::size_t g = point(i);
+                          if (g < nn || p2) {
+                            for (std::size_t k = 0; k < c; ++k) o.put(v[g * c + k]);
+                          } else {  // a P1 field at a mid-edge point: the mean of the edge's ends
+                            const auto [a, b] = mesh.edge(Index(g - nn));
+                            for (std::size_t k = 0; k < c; ++k)
+                              o.put(Real(0.5) * (v[std::size_t(a) * c + k] + v[std::size_t(b) * c + k]));
                           }
-                        };
-                        tuples(0, nn);
-                        if (order == 1) return;
-                        if (p2) return tuples(nn, ne);
-                        for (std::size_t e = 0; e < ne; ++e) {
-                          const auto [a, b] = mesh.edge(Index(e));
-                          for (std::size_t k = 0; k < c; ++k)
-                            o.put(Real(0.5) * (v[std::size_t(a) * c + k] + v[std::size_t(b) * c + k]));
                           for (std::size_t k = c; k < cw; ++k) o.put(Real(0));
                         }
                       }});
   }
   // --- cell data
-  arrays.push_back({1, "Int32", "region", 1, 4 * nc, [&mesh](AtomicFile& o) {
-                      for (int t : mesh.cell_tags()) o.put(std::int32_t(t));
+  arrays.push_back({1, "Int32", "region", 1, 4 * nc, [=, &mesh](AtomicFile& o) {
+                      for (std::size_t k = 0; k < nc; ++k) o.put(std::int32_t(mesh.cell_tags()[std::size_t(cell(k))]));
                     }});
   for (const VtuField& f : fields) {
     if (f.location != FieldLocation::cell) continue;
     const std::size_t c = std::size_t(f.components);
     const std::size_t cw = std::size_t(vtk_components<D>(f.components));
     const std::span<const Real> v = f.values;
-    arrays.push_back({1, "Float64", f.name, int(cw), 8 * cw * nc, [=](AtomicFile& o) {
-                        if (cw == c) return o.write(v.data(), v.size() * sizeof(Real));
-                        for (std::size_t i = 0; i < nc; ++i) {
-                          for (std::size_t k = 0; k < c; ++k) o.put(v[i * c + k]);
-                          for (std::size_t k = c; k < cw; ++k) o.put(Real(0));
+    arrays.push_back({1, "Float64", f.name, int(cw), 8 * cw * nc, [=, &sel](AtomicFile& o) {
+                        if (sel.whole && cw == c) return o.write(v.data(), v.size() * sizeof(Real));
+                        for (std::size_t k = 0; k < nc; ++k) {
+                          const std::size_t g = std::size_t(cell(k));
+                          for (std::size_t j = 0; j < c; ++j) o.put(v[g * c + j]);
+                          for (std::size_t j = c; j < cw; ++j) o.put(Real(0));
                         }
                       }});
   }
   // --- points
-  arrays.push_back({2, "Float64", "Points", 3, 24 * np, [&, order](AtomicFile& o) {
-                      auto point = [&](const Vec<D>& x) {
-                        o.put(x[0]), o.put(x[1]), o.put(D == 3 ? x[D - 1] : Real(0));
-                      };
-                      for (const auto& x : mesh.coordinates()) point(x);
-                      if (order == 1) return;
-                      if (!edge_midpoints.empty()) {
-                        for (const auto& x : edge_midpoints) point(x);
-                      } else {
-                        for (const auto& [a, b] : mesh.edges()) point(Real(0.5) * (mesh.node(a) + mesh.node(b)));
+  arrays.push_back({2, "Float64", "Points", 3, 24 * np, [=, &mesh](AtomicFile& o) {
+                      auto put = [&](const Vec<D>& x) { o.put(x[0]), o.put(x[1]), o.put(D == 3 ? x[D - 1] : Real(0)); };
+                      for (std::size_t i = 0; i < np; ++i) {
+                        const std::size_t g = point(i);
+                        if (g < nn) put(mesh.node(Index(g)));
+                        else if (!edge_midpoints.empty()) put(edge_midpoints[g - nn]);
+                        else put(Real(0.5) * (mesh.node(mesh.edge(Index(g - nn))[0]) + mesh.node(mesh.edge(Index(g - nn))[1])));
                       }
                     }});
   // --- cells
-  arrays.push_back({3, "Int64", "connectivity", 1, 8 * nc * std::size_t(npc), [&, order](AtomicFile& o) {
-                      for (Index c = 0; c < Index(nc); ++c) {
-                        for (Index v : mesh.cell(c)) o.put(std::int64_t(v));
+  arrays.push_back({3, "Int64", "connectivity", 1, 8 * nc * std::size_t(npc), [=, &mesh, &sel](AtomicFile& o) {
+                      auto id = [&](std::size_t g) { return std::int64_t(sel.whole ? Index(g) : sel.local[g]); };
+                      for (std::size_t k = 0; k < nc; ++k) {
+                        const Index c = cell(k);
+                        for (Index v : mesh.cell(c)) o.put(id(std::size_t(v)));
                         if (order == 2)
-                          for (Index e : mesh.cell_edges(c)) o.put(std::int64_t(nn) + e);
+                          for (Index e : mesh.cell_edges(c)) o.put(id(nn + std::size_t(e)));
                       }
                     }});
   arrays.push_back({3, "Int64", "offsets", 1, 8 * nc, [=](AtomicFile& o) {
-                      for (std::size_t c = 1; c <= nc; ++c) o.put(std::int64_t(c) * npc);
+                      for (std::size_t k = 1; k <= nc; ++k) o.put(std::int64_t(k) * npc);
                     }});
   arrays.push_back({3, "UInt8", "types", 1, nc, [=](AtomicFile& o) {
-                      for (std::size_t c = 0; c < nc; ++c) o.put(cell_type);
+                      for (std::size_t k = 0; k < nc; ++k) o.put(cell_type);
                     }});
+  return arrays;
+}
+
+template <int D>
+void write_vtu_to(AtomicFile& out, const Mesh<D>& mesh, std::span<const VtuField> fields, int order,
+                  std::span<const Vec<D>> edge_midpoints, const VtuSelection& sel) {
+  const std::vector<VtuArray> arrays = vtu_arrays(mesh, fields, order, edge_midpoints, sel);
+  const std::size_t np = sel.n_points(mesh, order), nc = sel.n_cells(mesh);
 
   // --- XML header
-  static constexpr std::array<const char*, 4> sections{"PointData", "CellData", "Points", "Cells"};
   std::string xml;
   xml.reserve(4096);
   xml += "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"";
@@ -348,7 +406,7 @@ void write_vtu_to(AtomicFile& out, const Mesh<D>& mesh, std::span<const VtuField
          "\" NumberOfCells=\"" + std::to_string(nc) + "\">\n";
   std::uint64_t offset = 0;
   for (int s = 0; s < 4; ++s) {
-    xml += std::string("      <") + sections[s] + ">\n";
+    xml += std::string("      <") + vtu_sections[s] + ">\n";
     for (const VtuArray& a : arrays) {
       if (a.section != s) continue;
       xml += "        <DataArray type=\"" + std::string(a.type) + "\" Name=\"" + xml_escape(a.name) +
@@ -356,7 +414,7 @@ void write_vtu_to(AtomicFile& out, const Mesh<D>& mesh, std::span<const VtuField
              std::to_string(offset) + "\"/>\n";
       offset += sizeof(std::uint64_t) + a.bytes;
     }
-    xml += std::string("      </") + sections[s] + ">\n";
+    xml += std::string("      </") + vtu_sections[s] + ">\n";
   }
   xml += "    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _";
   out.write(xml);
@@ -382,7 +440,7 @@ void write_vtu(const std::filesystem::path& file, const Mesh<D>& mesh, std::span
                int order = 1, std::span<const std::type_identity_t<Vec<D>>> edge_midpoints = {}) {
   detail::check_vtu_input(mesh, fields, order, edge_midpoints.size());
   detail::AtomicFile out(file);
-  detail::write_vtu_to(out, mesh, fields, order, edge_midpoints);
+  detail::write_vtu_to(out, mesh, fields, order, edge_midpoints, detail::VtuSelection{});
   out.commit();
 }
 
@@ -392,6 +450,65 @@ void write_vtu(const std::filesystem::path& file, const Mesh<D>& mesh, std::init
                int order = 1, std::span<const std::type_identity_t<Vec<D>>> edge_midpoints = {}) {
   write_vtu(file, mesh, std::span<const VtuField>(fields.begin(), fields.size()), order, edge_midpoints);
 }
+
+/// A piece of a partitioned output: the cells `cells` of `mesh` (increasing indices) and the
+/// points they use, written as write_vtu writes the whole mesh (the same arrays; fields hold
+/// the whole mesh's values, and the piece takes those of its points and cells). The points
+/// keep the mesh's order among themselves, so a point on the border of two pieces appears in
+/// both. An empty `cells` writes an empty piece. Checks and atomicity as write_vtu.
+template <int D>
+void write_vtu_piece(const std::filesystem::path& file, const Mesh<D>& mesh, std::span<const Index> cells,
+                     std::span<const VtuField> fields, int order = 1,
+                     std::span<const std::type_identity_t<Vec<D>>> edge_midpoints = {}) {
+  detail::check_vtu_input(mesh, fields, order, edge_midpoints.size());
+  const detail::VtuSelection sel = detail::select_cells(mesh, cells, order);
+  detail::AtomicFile out(file);
+  detail::write_vtu_to(out, mesh, fields, order, edge_midpoints, sel);
+  out.commit();
+}
+
+/// The parallel file (.pvtu) that shows the pieces `sources` (paths relative to the folder of
+/// `file`, each written by write_vtu_piece with these `fields` and `order`) as one grid:
+/// `<VTKFile type="PUnstructuredGrid">` naming every array with its type and components, then
+/// one `<Piece Source=...>` per source, in order. The pieces are not opened. Atomic as write_vtu.
+template <int D>
+void write_pvtu(const std::filesystem::path& file, const Mesh<D>& mesh, std::span<const VtuField> fields,
+                std::span<const std::string> sources, int order = 1) {
+  detail::check_vtu_input(mesh, fields, order, 0);
+  ALEFSI_CHECK_ARG(!sources.empty(), "sources", "a parallel file needs at least one piece");
+  for (std::size_t i = 0; i < sources.size(); ++i)
+    ALEFSI_CHECK_ARG(!sources[i].empty(), detail::concat("sources[", i, "]"), "is empty");
+  detail::VtuSelection none;
+  none.whole = false;  // (descriptions only: no bytes are written)
+  const std::vector<detail::VtuArray> arrays = detail::vtu_arrays(mesh, fields, order, {}, none);
+  std::string xml = "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"";
+  xml += detail::vtk_byte_order;
+  xml += "\" header_type=\"UInt64\">\n  <PUnstructuredGrid GhostLevel=\"0\">\n";
+  for (int s = 0; s < 3; ++s) {  // the cells' arrays are not declared in a parallel file
+    xml += std::string("    <P") + detail::vtu_sections[s] + ">\n";
+    for (const detail::VtuArray& a : arrays) {
+      if (a.section != s) continue;
+      xml += "      <PDataArray type=\"" + std::string(a.type) + "\"" +
+             (s == 2 ? std::string() : " Name=\"" + detail::xml_escape(a.name) + "\"") +
+             " NumberOfComponents=\"" + std::to_string(a.components) + "\"/>\n";
+    }
+    xml += std::string("    </P") + detail::vtu_sections[s] + ">\n";
+  }
+  for (const std::string& src : sources) xml += "    <Piece Source=\"" + detail::xml_escape(src) + "\"/>\n";
+  xml += "  </PUnstructuredGrid>\n</VTKFile>\n";
+  detail::AtomicFile out(file);
+  out.write(xml);
+  out.commit();
+}
+
+/// This process's share of a partitioned output (PvdWriter::write with a piece): its cells
+/// (increasing), its part among `parts`, and `all`, a collective call that returns whether its
+/// argument is true on every process (under MPI: an allreduce of AND).
+struct VtuPiece {
+  std::span<const Index> cells;
+  int part = 0, parts = 1;
+  std::function<bool(bool)> all;
+};
 
 /// A time series for ParaView: the collection file `run.pvd` and one `run/run_NNNNNN.vtu` per
 /// step in the sibling folder named after the collection's stem (created by the constructor).
@@ -406,9 +523,9 @@ class PvdWriter {
     ALEFSI_CHECK_ARG(!pvd_.filename().empty() && !stem_.empty() && stem_ != "." && stem_ != "..",
                      "pvd_file", "'", pvd_.string(), "' does not name a file");
     dir_ = pvd_.parent_path() / stem_;
-    std::error_code ec;
+    std::error_code ec;  // (processes of a parallel run may create it at the same time)
     std::filesystem::create_directories(dir_, ec);
-    if (ec || !std::filesystem::is_directory(dir_))
+    if (!std::filesystem::is_directory(dir_))
       throw IoError("cannot create directory '" + dir_.string() + "' for the steps of '" + pvd_.string() +
                     "': " + (ec ? ec.message() : std::string("not a directory")));
   }
@@ -418,13 +535,8 @@ class PvdWriter {
   template <int D>
   std::filesystem::path write(Real time, const Mesh<D>& mesh, std::span<const VtuField> fields, int order = 1,
                               std::span<const std::type_identity_t<Vec<D>>> edge_midpoints = {}) {
-    ALEFSI_CHECK_ARG(std::isfinite(time), "time", "must be finite, got ", time);
-    if (!steps_.empty())
-      ALEFSI_CHECK_ARG(time > steps_.back().time, "time", "must exceed the previous step's time ",
-                       detail::format_real(steps_.back().time), ", got ", detail::format_real(time));
-    std::string name = std::to_string(steps_.size());
-    if (name.size() < 6) name.insert(0, 6 - name.size(), '0');
-    name = stem_ + "_" + name + ".vtu";
+    check_time(time);
+    const std::string name = step_name() + ".vtu";
     const std::filesystem::path vtu = dir_ / name;
     write_vtu(vtu, mesh, fields, order, edge_midpoints);
     steps_.push_back({time, (std::filesystem::path(stem_) / name).generic_string()});
@@ -442,6 +554,65 @@ class PvdWriter {
     return write(time, mesh, std::span<const VtuField>(fields.begin(), fields.size()), order, edge_midpoints);
   }
 
+  /// One step of a run whose processes each hold a part of the cells (MPI): every process calls
+  /// it with the same arguments except `piece`. Each writes its cells to
+  /// `<stem>/<stem>_NNNNNN_pPPPP.vtu` (write_vtu_piece); once every piece is written, part 0
+  /// writes `<stem>/<stem>_NNNNNN.pvtu` (write_pvtu) and lists it in the collection. A failure on
+  /// any process throws on every process (IoError on those that did not fail) and leaves the
+  /// series as it was; the pieces of a step that failed may remain, unlisted. Returns the .pvtu.
+  template <int D>
+  std::filesystem::path write(Real time, const Mesh<D>& mesh, std::span<const VtuField> fields, const VtuPiece& piece,
+                              int order = 1, std::span<const std::type_identity_t<Vec<D>>> edge_midpoints = {}) {
+    ALEFSI_CHECK_ARG(piece.parts >= 1 && piece.part >= 0 && piece.part < piece.parts, "piece",
+                     "part ", piece.part, " of ", piece.parts, " parts");
+    ALEFSI_CHECK_ARG(piece.all != nullptr, "piece.all", "the collective test is empty");
+    check_time(time);
+    const std::string step = step_name();
+    auto source = [&](int k) {
+      std::string n = std::to_string(k);
+      if (n.size() < 4) n.insert(0, 4 - n.size(), '0');
+      return step + "_p" + n + ".vtu";
+    };
+    // every process reaches each agreement, whatever failed before it
+    auto agreed = [&](const std::function<void()>& act, const char* what) {
+      std::exception_ptr failed;
+      try {
+        act();
+      } catch (...) {
+        failed = std::current_exception();
+      }
+      if (piece.all(failed == nullptr)) return;
+      if (failed) std::rethrow_exception(failed);
+      throw IoError("step " + std::to_string(steps_.size()) + " of '" + pvd_.string() + "': another process could not " +
+                    what);
+    };
+    agreed([&] { write_vtu_piece(dir_ / source(piece.part), mesh, piece.cells, fields, order, edge_midpoints); },
+           "write its piece");
+    const std::filesystem::path pvtu = dir_ / (step + ".pvtu");
+    steps_.push_back({time, (std::filesystem::path(stem_) / (step + ".pvtu")).generic_string()});
+    try {
+      agreed(
+          [&] {
+            if (piece.part != 0) return;
+            std::vector<std::string> sources;
+            for (int k = 0; k < piece.parts; ++k) sources.push_back(source(k));
+            write_pvtu(pvtu, mesh, fields, sources, order);
+            write_collection();
+          },
+          "write the step's parallel file or the collection");
+    } catch (...) {
+      steps_.pop_back();
+      throw;
+    }
+    return pvtu;
+  }
+  template <int D>
+  std::filesystem::path write(Real time, const Mesh<D>& mesh, std::initializer_list<VtuField> fields,
+                              const VtuPiece& piece, int order = 1,
+                              std::span<const std::type_identity_t<Vec<D>>> edge_midpoints = {}) {
+    return write(time, mesh, std::span<const VtuField>(fields.begin(), fields.size()), piece, order, edge_midpoints);
+  }
+
   const std::filesystem::path& pvd_file() const { return pvd_; }
   /// The folder holding the steps' .vtu files.
   const std::filesystem::path& directory() const { return dir_; }
@@ -453,6 +624,19 @@ class PvdWriter {
     Real time;
     std::string file;  // relative to the collection's folder, '/'-separated
   };
+
+  void check_time(Real time) const {
+    ALEFSI_CHECK_ARG(std::isfinite(time), "time", "must be finite, got ", time);
+    if (!steps_.empty())
+      ALEFSI_CHECK_ARG(time > steps_.back().time, "time", "must exceed the previous step's time ",
+                       detail::format_real(steps_.back().time), ", got ", detail::format_real(time));
+  }
+  /// "<stem>_NNNNNN" for the next step.
+  std::string step_name() const {
+    std::string n = std::to_string(steps_.size());
+    if (n.size() < 6) n.insert(0, 6 - n.size(), '0');
+    return stem_ + "_" + n;
+  }
 
   void write_collection() const {
     std::string xml = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"";

@@ -378,6 +378,12 @@ TEST_CASE("a sphere settling in a spherical container: 10 steps through run() on
       odd.t_end = 2 * steps * dt, odd.vtu_every = PetscSession::rank() == 1 ? 0 : 1, odd.log = nullptr;
       CHECK_THROWS_AS(run(distributed, odd), InvalidArgument);
       CHECK(distributed.time() == Approx(steps * dt));
+      // rank 0 cannot create its folder (a file is in the way): every rank stops, none waits
+      RunOptions blocked = odd;
+      blocked.vtu_every = 0, blocked.output = dir / "bodies.csv" / "sub";
+      if (PetscSession::rank() == 0) CHECK_THROWS_AS(run(distributed, blocked), std::filesystem::filesystem_error);
+      else CHECK_THROWS_AS(run(distributed, blocked), IoError);
+      CHECK(distributed.time() == Approx(steps * dt));
     }
   }
 

@@ -56,6 +56,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -245,29 +246,44 @@ RunSummary run(Flow& flow, const RunOptions& options) {
   const Real t_start = flow.time();
   RunSummary sum;
 
+  // a file written by one process (the writer): in parts every process learns whether it
+  // failed, so that they stop together rather than wait for the one that threw
+  auto together = [&](const auto& act) {
+    std::exception_ptr failed;
+    try {
+      act();
+    } catch (...) {
+      failed = std::current_exception();
+    }
+    if (flow.all_parts(failed == nullptr)) return;
+    if (failed) std::rethrow_exception(failed);
+    throw IoError("the writing process could not write its output (its own error names the file)");
+  };
   std::ofstream csv;
   std::unique_ptr<PvdWriter> pvd;
-  if (!opt.output.empty()) {
-    std::filesystem::create_directories(opt.output);
-    const auto csv_path = opt.output / "bodies.csv";
-    const bool restart = t_start > 0 && std::filesystem::exists(csv_path);
-    if (restart) detail::truncate_csv_after(csv_path, t_start);
-    csv.open(csv_path, restart ? std::ios::app : std::ios::trunc);
-    if (!csv) throw IoError("cannot open '" + csv_path.string() + "' for writing");
-    csv << std::setprecision(17);
-    if (!restart) {
-      csv << "t,dt,newton,remeshed,worst_quality,error";
-      for (std::size_t k = 0; k < nb; ++k) detail::body_csv_header<typename Flow::BodyModel>(csv, k);
-      csv << '\n';
+  together([&] {
+    if (!opt.output.empty()) {
+      std::filesystem::create_directories(opt.output);
+      const auto csv_path = opt.output / "bodies.csv";
+      const bool restart = t_start > 0 && std::filesystem::exists(csv_path);
+      if (restart) detail::truncate_csv_after(csv_path, t_start);
+      csv.open(csv_path, restart ? std::ios::app : std::ios::trunc);
+      if (!csv) throw IoError("cannot open '" + csv_path.string() + "' for writing");
+      csv << std::setprecision(17);
+      if (!restart) {
+        csv << "t,dt,newton,remeshed,worst_quality,error";
+        for (std::size_t k = 0; k < nb; ++k) detail::body_csv_header<typename Flow::BodyModel>(csv, k);
+        csv << '\n';
+      }
     }
-  }
-  const std::filesystem::path vtu_output = pieces ? options.output : opt.output;  // pieces: every process
-  if (!vtu_output.empty() && opt.vtu_every > 0) {
-    std::filesystem::create_directories(vtu_output);
-    const std::string name =
-        t_start > 0 ? "flow_from_" + std::to_string(flow.stats().steps) + ".pvd" : std::string("flow.pvd");
-    pvd = std::make_unique<PvdWriter>(vtu_output / name);
-  }
+    const std::filesystem::path vtu_output = pieces ? options.output : opt.output;  // pieces: every process
+    if (!vtu_output.empty() && opt.vtu_every > 0) {
+      std::filesystem::create_directories(vtu_output);
+      const std::string name =
+          t_start > 0 ? "flow_from_" + std::to_string(flow.stats().steps) + ".pvd" : std::string("flow.pvd");
+      pvd = std::make_unique<PvdWriter>(vtu_output / name);
+    }
+  });
   std::vector<Real> u, p, w;
   auto write_vtu_now = [&] {
     detail::nodal_fields(flow, u, p, w);
@@ -392,7 +408,9 @@ RunSummary run(Flow& flow, const RunOptions& options) {
     const int n = flow.stats().steps;
     const bool last = left() <= 1e-9 * opt.dt;
     if (pvd && n % opt.vtu_every == 0) write_vtu_now();
-    if (checkpoints && (n % opt.checkpoint_every == 0 || last)) flow.save_checkpoint(checkpoint);
+    together([&] {
+      if (checkpoints && (n % opt.checkpoint_every == 0 || last)) flow.save_checkpoint(checkpoint);
+    });
     if (opt.on_step) opt.on_step();
     if (opt.progress_every > 0 && (n % opt.progress_every == 0 || last)) {
       const Real el = wall(), frac = (flow.time() - t_start) / (opt.t_end - t_start);

@@ -814,6 +814,10 @@ TEST_CASE("PvdWriter: a series of pieces, and a failed piece on one process", "[
                                     }}),
                   InvalidArgument);
   CHECK(asked);  // it reached the collective call before throwing
+  // part 0 alone (the others wrote elsewhere): it finds no pieces of theirs and lists nothing
+  agree = true;
+  CHECK_THROWS_WITH(step(1.0, values[0], 0), Catch::Contains("the piece of part 1 is not in") &&
+                                                 Catch::Contains("same output folder"));
   for (const auto& w : writers) CHECK(w->steps() == 2);
   CHECK(slurp(pvd) == listed);
 

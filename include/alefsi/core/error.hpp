@@ -10,6 +10,7 @@
 ///     catch (const alefsi::ParseError& e) { std::cerr << e.file() << ':' << e.line(); }
 #include <cstddef>
 #include <cstdio>
+#include <exception>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -96,6 +97,28 @@ std::string concat(const Args&... args) {
   std::ostringstream os;
   (os << ... << args);
   return os.str();
+}
+/// Runs `act` on each process of a parallel run and then `all(ok)`, a collective call that
+/// tells whether `act` succeeded on every process; when it failed somewhere, its exception is
+/// rethrown where it was thrown and IoError(`elsewhere`) is thrown on the others, so that the
+/// processes stop together instead of waiting for the one that threw.
+template <class Act, class All>
+void together(const Act& act, const All& all, const std::string& elsewhere) {
+  std::exception_ptr failed;
+  try {
+    act();
+  } catch (...) {
+    failed = std::current_exception();
+  }
+  if (all(failed == nullptr)) return;
+  if (failed) std::rethrow_exception(failed);
+  throw IoError(elsewhere);
+}
+/// n in decimal with leading zeros up to `width` digits ("000042"), for file names.
+inline std::string zero_padded(long n, std::size_t width) {
+  std::string s = std::to_string(n);
+  if (s.size() < width) s.insert(0, width - s.size(), '0');
+  return s;
 }
 /// x in scientific notation with four significant digits ("1.234e-05"), for messages.
 inline std::string sci(Real x) {

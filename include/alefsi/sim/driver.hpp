@@ -47,9 +47,10 @@
 ///  * a progress line every `progress_every` steps (and at the end) on `log`.
 ///  * under MPI: only the process with `writer` set (rank 0) writes the CSV, the checkpoints and
 ///    the log. When the processes assemble parts of the cells (AleFlow::in_parts), each writes
-///    its cells' VTU piece `<output>/flow/flow_NNNNNN_pPPPP.vtu` and part 0 writes the step's
-///    `.pvtu` and the PVD that lists it (PvdWriter with a VtuPiece): the pieces need the same
-///    `output` and `vtu_every` on every process and a folder they all see.
+///    its cells' VTU piece `<output>/flow/flow_NNNNNN_pPPPP.vtu` (after a restart in
+///    `flow_from_<step>/`) and part 0 writes the step's `.pvtu` and the PVD that lists it
+///    (PvdWriter with a VtuPiece): the processes need the same `output`, `vtu_every` and
+///    `checkpoint_every` (refused before the first step otherwise) and a folder they all see.
 ///
 ///     alefsi::RunOptions opt{.dt = 1e-3, .t_end = 0.5, .output = "out", .vtu_every = 50};
 ///     alefsi::RunSummary s = alefsi::run(flow, opt);
@@ -107,7 +108,7 @@ struct RunOptions {
   std::ostream* log = &std::cout;   ///< progress and remarks; nullptr: silent
   /// Whether this process writes the files and the log. Under MPI with the shared-mesh model
   /// (la/petsc.hpp) every rank holds the whole state: rank 0 writes (`PetscSession::rank() ==
-  /// 0`), the others step in lockstep and write only their VTU pieces (file comment). A
+  /// 0`), the others step in lockstep and write nothing but, in parts, their VTU pieces (file comment). A
   /// checkpoint is then the same on any number of ranks and restarts on any other.
   bool writer = true;
   /// Called after every accepted step (e.g. extra monitoring); may throw to stop the run.
@@ -227,15 +228,19 @@ RunSummary run(Flow& flow, const RunOptions& options) {
   flow.prepare();  // a scene that cannot run is refused before anything is written
   ALEFSI_CHECK_ARG(options.checkpoint_every == 0 || options.output.empty() || !flow.geometry(), "checkpoint_every",
                    "flows with curved boundaries cannot be checkpointed yet: set it to 0");
-  // in parts every process writes its VTU piece, at the same steps (a collective check)
+  // in parts every process writes its VTU piece and learns of the writer's checkpoints, at the
+  // same steps (a collective check)
   bool pieces = false;
+  const int every = options.output.empty() ? 0 : options.vtu_every;
+  const int checkpoint_every = options.output.empty() ? 0 : options.checkpoint_every;
   if (flow.in_parts()) {
-    const int every = options.output.empty() ? 0 : options.vtu_every;
-    std::vector<int> w{every, -every};
+    std::vector<int> w{every, -every, checkpoint_every, -checkpoint_every};
     flow.min_parts(w);
     ALEFSI_CHECK_ARG(w[0] == -w[1], "vtu_every",
                      "in parts every process writes its VTU piece at the same steps: give every process the same "
                      "output folder and vtu_every (they range from ", w[0], " to ", -w[1], ")");
+    ALEFSI_CHECK_ARG(w[2] == -w[3], "checkpoint_every", "must be the same on every process (they range from ", w[2],
+                     " to ", -w[3], ")");
     pieces = every > 0;
   }
   RunOptions opt = options;  // (every check above is made on every rank: they all stop together)
@@ -247,17 +252,11 @@ RunSummary run(Flow& flow, const RunOptions& options) {
   RunSummary sum;
 
   // a file written by one process (the writer): in parts every process learns whether it
-  // failed, so that they stop together rather than wait for the one that threw
+  // failed, so that they stop together rather than wait for the one that threw. (Under MPI
+  // outside parts, nothing tells the others: the flows in parts are the MPI ones, sim/discretisation.hpp.)
   auto together = [&](const auto& act) {
-    std::exception_ptr failed;
-    try {
-      act();
-    } catch (...) {
-      failed = std::current_exception();
-    }
-    if (flow.all_parts(failed == nullptr)) return;
-    if (failed) std::rethrow_exception(failed);
-    throw IoError("the writing process could not write its output (its own error names the file)");
+    detail::together(act, [&](bool ok) { return flow.all_parts(ok); },
+                     "the writing process could not write its output (its own error names the file)");
   };
   std::ofstream csv;
   std::unique_ptr<PvdWriter> pvd;
@@ -408,9 +407,10 @@ RunSummary run(Flow& flow, const RunOptions& options) {
     const int n = flow.stats().steps;
     const bool last = left() <= 1e-9 * opt.dt;
     if (pvd && n % opt.vtu_every == 0) write_vtu_now();
-    together([&] {
-      if (checkpoints && (n % opt.checkpoint_every == 0 || last)) flow.save_checkpoint(checkpoint);
-    });
+    if (checkpoint_every > 0 && (n % checkpoint_every == 0 || last))  // (the same on every process)
+      together([&] {
+        if (checkpoints) flow.save_checkpoint(checkpoint);
+      });
     if (opt.on_step) opt.on_step();
     if (opt.progress_every > 0 && (n % opt.progress_every == 0 || last)) {
       const Real el = wall(), frac = (flow.time() - t_start) / (opt.t_end - t_start);

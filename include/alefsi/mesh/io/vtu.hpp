@@ -308,7 +308,8 @@ struct VtuArray {
 
 inline constexpr std::array<const char*, 4> vtu_sections{"PointData", "CellData", "Points", "Cells"};
 
-/// The arrays of a file of `mesh`'s selected cells, in the order they are written.
+/// The arrays of a file of `mesh`'s selected cells, in the order they are written. Their
+/// writers refer to `mesh`, `sel`, the fields' values and `edge_midpoints`, which must outlive them.
 template <int D>
 std::vector<VtuArray> vtu_arrays(const Mesh<D>& mesh, std::span<const VtuField> fields, int order,
                                  std::span<const Vec<D>> edge_midpoints, const VtuSelection& sel) {
@@ -330,8 +331,12 @@ std::vector<VtuArray> vtu_arrays(const Mesh<D>& mesh, std::span<const VtuField> 
     const std::span<const Real> v = f.values;
     arrays.push_back({0, "Float64", f.name, int(cw), 8 * cw * np, [=, &mesh, &sel](AtomicFile& o) {
                         // the whole mesh's tuples lie in order in v, unless padded or interpolated
-                        if (sel.whole && cw == c && (order == 1 || p2)) return o.write(v.data(), np * c * sizeof(Real));
-                        for (std::size_t i = 0; i < np; ++i) {
+                        std::size_t i = 0;
+                        if (sel.whole && cw == c) {
+                          i = order == 1 || p2 ? np : nn;  // a P1 field at order 2: its mid-edge values below
+                          o.write(v.data(), i * c * sizeof(Real));
+                        }
+                        for (; i < np; ++i) {
                           const std::size_t g = point(i);
                           if (g < nn || p2) {
                             for (std::size_t k = 0; k < c; ++k) o.put(v[g * c + k]);
@@ -511,7 +516,9 @@ struct VtuPiece {
 };
 
 /// A time series for ParaView: the collection file `run.pvd` and one `run/run_NNNNNN.vtu` per
-/// step in the sibling folder named after the collection's stem (created by the constructor).
+/// step in the sibling folder named after the collection's stem (created by the constructor);
+/// in pieces (write with a VtuPiece), `run/run_NNNNNN.pvtu` and its pieces
+/// `run/run_NNNNNN_pPPPP.vtu` instead.
 /// After every step the collection is rewritten atomically, so it always lists exactly the
 /// completed steps (a crashed run leaves a readable series). Times must increase strictly.
 /// Starting a series replaces an existing collection of that name at the first step; stale
@@ -568,38 +575,29 @@ class PvdWriter {
     ALEFSI_CHECK_ARG(piece.all != nullptr, "piece.all", "the collective test is empty");
     check_time(time);
     const std::string step = step_name();
-    auto source = [&](int k) {
-      std::string n = std::to_string(k);
-      if (n.size() < 4) n.insert(0, 4 - n.size(), '0');
-      return step + "_p" + n + ".vtu";
-    };
+    auto source = [&](int k) { return step + "_p" + detail::zero_padded(k, 4) + ".vtu"; };
     // every process reaches each agreement, whatever failed before it
-    auto agreed = [&](const std::function<void()>& act, const char* what) {
-      std::exception_ptr failed;
-      try {
-        act();
-      } catch (...) {
-        failed = std::current_exception();
-      }
-      if (piece.all(failed == nullptr)) return;
-      if (failed) std::rethrow_exception(failed);
-      throw IoError("step " + std::to_string(steps_.size()) + " of '" + pvd_.string() + "': another process could not " +
-                    what);
-    };
-    agreed([&] { write_vtu_piece(dir_ / source(piece.part), mesh, piece.cells, fields, order, edge_midpoints); },
-           "write its piece");
+    const std::string elsewhere = "step " + std::to_string(steps_.size()) + " of '" + pvd_.string() + "': ";
+    detail::together(
+        [&] { write_vtu_piece(dir_ / source(piece.part), mesh, piece.cells, fields, order, edge_midpoints); },
+        piece.all, elsewhere + "another process could not write its piece");
     const std::filesystem::path pvtu = dir_ / (step + ".pvtu");
     steps_.push_back({time, (std::filesystem::path(stem_) / (step + ".pvtu")).generic_string()});
     try {
-      agreed(
+      detail::together(
           [&] {
             if (piece.part != 0) return;
             std::vector<std::string> sources;
-            for (int k = 0; k < piece.parts; ++k) sources.push_back(source(k));
+            for (int k = 0; k < piece.parts; ++k) {
+              sources.push_back(source(k));
+              if (!std::filesystem::is_regular_file(dir_ / sources.back()))  // another folder, or one not shared
+                throw IoError(elsewhere + "the piece of part " + std::to_string(k) + " is not in '" + dir_.string() +
+                              "': every process needs the same output folder, visible to part 0");
+            }
             write_pvtu(pvtu, mesh, fields, sources, order);
             write_collection();
           },
-          "write the step's parallel file or the collection");
+          piece.all, elsewhere + "part 0 could not write the step's parallel file or the collection");
     } catch (...) {
       steps_.pop_back();
       throw;
@@ -614,7 +612,7 @@ class PvdWriter {
   }
 
   const std::filesystem::path& pvd_file() const { return pvd_; }
-  /// The folder holding the steps' .vtu files.
+  /// The folder holding the steps' files (.vtu; in pieces .pvtu and the pieces).
   const std::filesystem::path& directory() const { return dir_; }
   /// Number of steps written (and listed in the collection).
   std::size_t steps() const { return steps_.size(); }
@@ -632,11 +630,7 @@ class PvdWriter {
                        detail::format_real(steps_.back().time), ", got ", detail::format_real(time));
   }
   /// "<stem>_NNNNNN" for the next step.
-  std::string step_name() const {
-    std::string n = std::to_string(steps_.size());
-    if (n.size() < 6) n.insert(0, 6 - n.size(), '0');
-    return stem_ + "_" + n;
-  }
+  std::string step_name() const { return stem_ + "_" + detail::zero_padded(long(steps_.size()), 6); }
 
   void write_collection() const {
     std::string xml = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"";

@@ -18,6 +18,10 @@
 //                   fieldsplit Schur, BoomerAMG, selfp), petsc-mass (with the blocks: the
 //                   pressure mass), mumps (PetscDirect). Under `mpirun -n P` pass only these:
 //                   every rank runs the others too. PETSc options after "--".
+//          --parts   (PETSc solvers, under mpirun) each rank keeps only the matrix of its cells
+//                   (Morton parts, la/partition.hpp) and PETSc sums the parts, as a flow does
+//                   (sim/discretisation.hpp); the whole matrix is dropped before the solvers,
+//                   the residual is the sum of the parts' products. Peak MB: the largest rank's.
 //          --direct-max N   (default 16) largest N for the direct solvers
 //          --tol T   (default 1e-8) GMRES relative tolerance; --restart M (default 60);
 //          --augment K (default 2: LGMRES corrections kept across restarts, 0: GMRES(M))
@@ -91,6 +95,7 @@ struct Options {
   std::vector<std::string> solvers{"krylov", "krylov-mass", "umfpack"};
   int direct_max = 16;
   double mass = 0;
+  bool parts = false;
   KrylovOptions krylov;
 };
 
@@ -145,17 +150,51 @@ Row run(const System& s, Solver&& solver, VecX& x) {
   return row;
 }
 
+#ifdef ALEFSI_HAVE_PETSC
+/// In parts: the rank's matrix `part`, summed by PETSc; the residual sums the parts' products
+/// and the peak is the largest rank's.
+template <class Solver>
+Row run_parts(const SparseMatrix& part, const VecX& b, Solver&& solver, VecX& x) {
+  Row row;
+  reset_peak_rss();
+  const double c0 = cpu_seconds(), w0 = wall_seconds();
+  solver.set_summed(true);
+  solver.analyze(part);
+  solver.factorize(part);
+  const double c1 = cpu_seconds();
+  x = solver.solve(b);
+  const double c2 = cpu_seconds(), w2 = wall_seconds();
+  row.setup = c1 - c0, row.solve = c2 - c1, row.wall = w2 - w0;
+  std::vector<int> peak{-int(status_mb("VmHWM:"))};
+  solver.min(peak);
+  row.peak = -peak[0];
+  VecX r = part * x;
+  solver.sum(r);
+  row.relres = (r - b).norm() / b.norm();
+  if constexpr (requires { solver.iterations(); }) row.iterations = solver.iterations();
+  return row;
+}
+#endif
+
 template <class Pair>
 void bench(const Options& o, const char* pair) {
   for (int n : o.sizes) {
     const double c0 = cpu_seconds();
-    const System s = cavity3d<Pair>(n, o.mass);
-    const double assemble = cpu_seconds() - c0;
+#ifdef ALEFSI_HAVE_PETSC
+    const int parts = o.parts ? PetscSession::size() : 1, me = o.parts ? PetscSession::rank() : 0;
+#else
+    const int parts = 1, me = 0;
+#endif
+    System s = cavity3d<Pair>(n, o.mass, parts, me);
+    const double assemble = cpu_seconds() - c0;  // (in parts: the whole matrix, then the part)
+    const Index rows = s.A.rows();
+    const double nnz = double(s.A.nonZeros());
+    if (parts > 1) s.A = SparseMatrix(), malloc_trim(0);  // the ranks keep their parts only
     const double base = status_mb("VmRSS:");
     std::optional<VecX> direct;
     // velocity and pressure errors against the direct solution, the pressure modulo a constant
     // (pinning DOF 0 leaves the constant mode nearly singular: it carries most of x - x_direct)
-    const Index nu = s.A.rows() - s.blocks.n_pressure - s.blocks.n_extra, np = s.blocks.n_pressure;
+    const Index nu = rows - s.blocks.n_pressure - s.blocks.n_extra, np = s.blocks.n_pressure;
     auto difference = [&](const VecX& x) {
       const VecX du = x.head(nu) - direct->head(nu);
       VecX dp = x.segment(nu, np) - direct->segment(nu, np);
@@ -168,16 +207,38 @@ void bench(const Options& o, const char* pair) {
     };
     auto print = [&](const char* solver, const Row& r, const VecX& x) {
       std::printf("| %s | %d | %d | %.3g | %s | %.3g | %.3g | %.3g | %s | %s | %.0f | %.1e | %s |\n", pair, n,
-                  int(s.A.rows()), double(s.A.nonZeros()), solver, r.setup, r.solve, r.wall,
+                  int(rows), nnz, solver, r.setup, r.solve, r.wall,
                   r.iterations >= 0 ? std::to_string(r.iterations).c_str() : "",
                   r.levels ? (std::to_string(r.levels) + " / " + std::to_string(r.complexity).substr(0, 4)).c_str() : "",
                   r.peak, r.relres,
                   direct ? difference(x).c_str() : "");
       std::fflush(stdout);
     };
-    std::fprintf(stderr, "%s N = %d: %d unknowns, assembled in %.1f s CPU, base %.0f MB\n", pair, n, int(s.A.rows()),
-                 assemble, base);
+    std::fprintf(stderr, "%s N = %d: %d unknowns, assembled in %.1f s CPU, base %.0f MB%s\n", pair, n, int(rows),
+                 assemble, base, parts > 1 ? " (this rank, its part)" : "");
     VecX x;
+#ifdef ALEFSI_HAVE_PETSC
+    if (parts > 1) {  // only the PETSc solvers take parts
+      const std::string label = " (" + std::to_string(parts) + " ranks, parts)";
+      const PetscKrylovOptions popt{.tolerance = o.krylov.tolerance, .restart = o.krylov.restart};
+      if (has(o.solvers, "mumps") && n <= o.direct_max) {
+        const Row r = run_parts(s.part, s.b, PetscDirect{}, x);
+        direct = x;
+        print(("PETSc MUMPS LU" + label).c_str(), r, x);
+      }
+      for (const char* name : {"petsc", "petsc-mass"}) {
+        if (!has(o.solvers, name)) continue;
+        SaddlePointBlocks blocks = s.blocks;  // in parts a rank's diagonal cannot tell the pressures
+        if (std::string(name) == "petsc") blocks.pressure_mass = SparseMatrix();  // PetscKrylov: selfp
+        PetscKrylov<3> k(popt);
+        k.set_blocks(blocks);
+        const Row r = run_parts(s.part, s.b, k, x);
+        print(("PETSc GMRES + fieldsplit (BoomerAMG, " + std::string(name == std::string("petsc") ? "selfp" : "pressure mass") +
+               ")" + label).c_str(), r, x);
+      }
+      continue;
+    }
+#endif
 #ifdef ALEFSI_HAVE_SUITESPARSE
     if (has(o.solvers, "umfpack") && n <= o.direct_max) {
       try {
@@ -274,11 +335,23 @@ int main(int argc, char** argv) {
     else if (a == "--cycles") o.krylov.velocity_cycles = std::stoi(next());
     else if (a == "--coarse") o.krylov.amg.coarse_size = std::stoi(next());
     else if (a == "--mass") o.mass = std::stod(next());
+    else if (a == "--parts") o.parts = true;
     else {
       std::fprintf(stderr, "unknown option %s\n", a.c_str());
       return 2;
     }
   }
+#ifdef ALEFSI_HAVE_PETSC
+  if (o.parts && (o.mass != 0 || !(has(o.solvers, "petsc") || has(o.solvers, "petsc-mass") || has(o.solvers, "mumps")))) {
+    std::fprintf(stderr, "--parts takes the PETSc solvers (petsc, petsc-mass, mumps) and no --mass\n");
+    return 2;
+  }
+#else
+  if (o.parts) {
+    std::fprintf(stderr, "--parts needs PETSc (this build has none)\n");
+    return 2;
+  }
+#endif
   std::printf("| pair | N | unknowns | nnz | solver | set-up s | solve s | wall s | its | AMG levels / complexity | peak MB | residual | vs direct: u / p |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   if (has(o.pairs, "P2P1")) bench<TaylorHood>(o, "P2/P1");

@@ -342,7 +342,19 @@ class PetscSystem {
   /// Copies the values of A, whose pattern is the one just analysed (no check).
   void set_values(const SparseMatrix& A) {
     const Real* v = A.valuePtr();
-    for (std::size_t e = 0; e < position_.size(); ++e) values_[e] = PetscScalar(v[position_[e]]);
+    if constexpr (std::is_same_v<PetscScalar, Real>) {
+      if (all_entries_) {  // the COO order is A's own: its value array as it is
+        ALEFSI_ASSERT(A.nonZeros() == nnz_);
+        ALEFSI_PETSC(MatSetValuesCOO(mat_, v, INSERT_VALUES));
+        ALEFSI_PETSC(KSPSetOperators(ksp_, mat_, mat_));
+        return;
+      }
+    }
+    if (all_entries_) {
+      for (Index e = 0; e < nnz_; ++e) values_[std::size_t(e)] = PetscScalar(v[e]);
+    } else {
+      for (std::size_t e = 0; e < position_.size(); ++e) values_[e] = PetscScalar(v[position_[e]]);
+    }
     ALEFSI_PETSC(MatSetValuesCOO(mat_, values_.data(), INSERT_VALUES));
     ALEFSI_PETSC(KSPSetOperators(ksp_, mat_, mat_));
   }
@@ -362,8 +374,9 @@ class PetscSystem {
     hash_ = detail::pattern_hash(A);
     PetscInt local = PETSC_DECIDE, global = PetscInt(n_);
     std::vector<PetscInt> ci, cj;
-    position_.clear();
+    position_.clear(), values_.clear();
     owned_.clear();
+    all_entries_ = summed_;
     if (!summed_) {  // contiguous ranges of the library's numbering; each rank sets its rows
       perm_.clear();
       ALEFSI_PETSC(PetscSplitOwnership(PETSC_COMM_WORLD, &local, &global));
@@ -398,13 +411,15 @@ class PetscSystem {
         perm_[std::size_t(i)] = PetscInt(begin[std::size_t(p)]++);
         if (p == rank) owned_.push_back(i);
       }
-      ci.reserve(std::size_t(nnz_)), cj.reserve(std::size_t(nnz_)), position_.reserve(std::size_t(nnz_));
-      for (Index j = 0; j < n_; ++j)  // every entry of the part: PETSc sends the others' rows
+      ci.reserve(std::size_t(nnz_)), cj.reserve(std::size_t(nnz_));
+      for (Index j = 0; j < n_; ++j)  // every entry of the part, in A's order: PETSc sends the others' rows
         for (Index k = A.outerIndexPtr()[j]; k < A.outerIndexPtr()[j + 1]; ++k)
-          ci.push_back(perm_[std::size_t(A.innerIndexPtr()[k])]), cj.push_back(perm_[std::size_t(j)]),
-              position_.push_back(k);
+          ci.push_back(perm_[std::size_t(A.innerIndexPtr()[k])]), cj.push_back(perm_[std::size_t(j)]);
     }
-    values_.resize(position_.size());
+    // the values in COO order: the positions of the owned rows' entries (whole matrices), or
+    // all of A's entries in its order (parts: no copy when PETSc's scalar is ours)
+    if (!all_entries_) values_.resize(position_.size());
+    else if (!std::is_same_v<PetscScalar, Real>) values_.resize(std::size_t(nnz_));
     ALEFSI_PETSC(MatCreate(PETSC_COMM_WORLD, &mat_));
     ALEFSI_PETSC(MatSetSizes(mat_, local, local, global, global));
     ALEFSI_PETSC(MatSetType(mat_, MATAIJ));
@@ -507,6 +522,7 @@ class PetscSystem {
   Index n_ = 0, nnz_ = 0, row_begin_ = 0, row_end_ = 0;
   std::uint64_t hash_ = 0;
   std::vector<Index> position_;       // value-array positions of this rank's entries (COO order)
+  bool all_entries_ = false;          // parts: the COO entries are all of A's, in its order
   std::vector<Index> owned_;          // the library's indices of this rank's rows (PETSc order)
   std::vector<PetscInt> perm_;        // PETSc's row of each unknown (empty: the same index)
   bool summed_ = false;

@@ -213,6 +213,7 @@ class Discretisation {
   const Motion& motion() const { return *motion_; }
   DofConstraints& constraints() { return *cons_; }
   const DofConstraints& constraints() const { return *cons_; }
+  /// The assembler of this process's cells: all of them, or its part (in_parts()).
   const FlowAssembler& assembler() const { return *asmb_; }
   SparseMatrix& jacobian() { return J_; }
   LinearSolve<Solver>& linear_solve() { return solve_; }

@@ -2,6 +2,7 @@
 // disk in simple shear, and stability at extreme density ratios.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <numbers>
@@ -9,6 +10,7 @@
 
 #include "alefsi/mesh/generate/mesher2d.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
+#include "alefsi/physics/mass_properties.hpp"
 #include "alefsi/scenes/annulus.hpp"
 #include "alefsi/sim/ale_flow.hpp"
 
@@ -155,4 +157,61 @@ TEST_CASE("2D squirmer: a disk with slip B1 sin(theta) swims at U = B1 / 2 (Blak
   CHECK(Z[0] == Approx(B1 / 2).epsilon(0.05));
   CHECK(std::abs(Z[1]) < 1e-3 * B1);
   CHECK(std::abs(Z[2]) < 1e-3 * B1 / a);
+}
+
+TEST_CASE("mass_properties: analytic values for disks, ellipses, polygons, spheres and ellipsoids", "[bodies][quick]") {
+  using std::numbers::pi;
+  const Real rho = 1.5;
+  // disk and ellipse: m = rho pi a b, I = m (a^2 + b^2) / 4
+  const auto d = mass_properties(Circle{{1, 2}, 0.5, 3}, rho);
+  CHECK(d.mass == Approx(rho * pi * 0.25));
+  CHECK(d.inertia == Approx(0.5 * d.mass * 0.25));
+  CHECK(d.centre == Vec<2>(1, 2));
+  const Ellipse e{{-1, 0.5}, 0.3, 0.1, 0.7, 4};
+  const auto pe = mass_properties(e, rho);
+  CHECK(pe.mass == Approx(rho * pi * 0.03));
+  CHECK(pe.inertia == Approx(0.25 * pe.mass * (0.09 + 0.01)));
+  // a rectangle w x h far from the origin, both orientations: I = m (w^2 + h^2) / 12
+  const Real w = 0.4, h = 0.1;
+  const Vec<2> c0(1e3, -2e3);
+  Polyline rect{{c0 + Vec<2>(-w / 2, -h / 2), c0 + Vec<2>(w / 2, -h / 2), c0 + Vec<2>(w / 2, h / 2),
+                 c0 + Vec<2>(-w / 2, h / 2)}};
+  for (int flip = 0; flip < 2; ++flip) {
+    const auto pr = mass_properties(rect, rho);
+    CHECK(pr.mass == Approx(rho * w * h).epsilon(1e-12));
+    CHECK((pr.centre - c0).norm() <= 1e-9);
+    CHECK(pr.inertia == Approx(pr.mass * (w * w + h * h) / 12).epsilon(1e-8));
+    std::reverse(rect.points.begin(), rect.points.end());
+  }
+  // the ellipse's inscribed n-gon converges to it at second order (errors O(n^-2))
+  std::vector<Real> err;
+  for (int n : {64, 128, 256}) {
+    Polyline poly;
+    for (int k = 0; k < n; ++k) poly.points.push_back(e.at(2 * pi * k / n));
+    const auto pp = mass_properties(poly, rho);
+    CHECK((pp.centre - e.centre).norm() <= 1e-13);
+    err.push_back(std::abs(pp.inertia - pe.inertia) / pe.inertia);
+  }
+  CHECK(std::log2(err[0] / err[1]) == Approx(2).margin(0.01));
+  CHECK(std::log2(err[1] / err[2]) == Approx(2).margin(0.01));
+  // 3D: a sphere, and an ellipsoid whose equal axes make it a sphere
+  const auto s = sphere_mass_properties(Vec<3>(0, 1, 2), 0.5, rho);
+  CHECK(s.mass == Approx(rho * 4.0 / 3.0 * pi * 0.125));
+  CHECK((s.inertia - Mat<3>::Identity() * 0.4 * s.mass * 0.25).norm() <= 1e-15);
+  const auto es = ellipsoid_mass_properties(Vec<3>(0, 1, 2), Vec<3>(0.5, 0.5, 0.5), rho);
+  CHECK((es.inertia - s.inertia).norm() <= 1e-15);
+  const auto el = ellipsoid_mass_properties(Vec<3>::Zero(), Vec<3>(0.3, 0.2, 0.1), rho);
+  CHECK(el.mass == Approx(rho * 4.0 / 3.0 * pi * 0.006));
+  CHECK(el.inertia(0, 0) == Approx(el.mass / 5 * (0.04 + 0.01)));
+  CHECK(el.inertia(2, 2) == Approx(el.mass / 5 * (0.09 + 0.04)));
+  CHECK(el.inertia(0, 1) == 0);
+  // the bodies they make pass the bodies' own checks
+  CHECK_NOTHROW(free_body(3, pe).validate(0));
+  CHECK_NOTHROW(free_body(3, el).validate(0));
+  // bad input names the parameter
+  CHECK_THROWS_WITH(mass_properties(e, 0.0), Catch::Contains("density"));
+  CHECK_THROWS_WITH(mass_properties(Polyline{{Vec<2>(0, 0), Vec<2>(1, 0)}}, rho), Catch::Contains("points"));
+  CHECK_THROWS_WITH(mass_properties(Polyline{{Vec<2>(0, 0), Vec<2>(1, 0), Vec<2>(2, 0)}}, rho),
+                    Catch::Contains("no area"));
+  CHECK_THROWS_WITH(ellipsoid_mass_properties(Vec<3>::Zero(), Vec<3>(1, -1, 1), rho), Catch::Contains("semi_axes[1]"));
 }

@@ -342,20 +342,15 @@ class PetscSystem {
   /// Copies the values of A, whose pattern is the one just analysed (no check).
   void set_values(const SparseMatrix& A) {
     const Real* v = A.valuePtr();
-    if constexpr (std::is_same_v<PetscScalar, Real>) {
-      if (all_entries_) {  // the COO order is A's own: its value array as it is
-        ALEFSI_ASSERT(A.nonZeros() == nnz_);
-        ALEFSI_PETSC(MatSetValuesCOO(mat_, v, INSERT_VALUES));
-        ALEFSI_PETSC(KSPSetOperators(ksp_, mat_, mat_));
-        return;
-      }
-    }
-    if (all_entries_) {
-      for (Index e = 0; e < nnz_; ++e) values_[std::size_t(e)] = PetscScalar(v[e]);
+    const PetscScalar* coo = values_.data();
+    if (all_entries_) {  // the COO order is A's own: its value array as it is
+      ALEFSI_ASSERT(A.nonZeros() == nnz_);
+      if constexpr (std::is_same_v<PetscScalar, Real>) coo = v;
+      else for (Index e = 0; e < nnz_; ++e) values_[std::size_t(e)] = PetscScalar(v[e]);
     } else {
       for (std::size_t e = 0; e < position_.size(); ++e) values_[e] = PetscScalar(v[position_[e]]);
     }
-    ALEFSI_PETSC(MatSetValuesCOO(mat_, values_.data(), INSERT_VALUES));
+    ALEFSI_PETSC(MatSetValuesCOO(mat_, coo, INSERT_VALUES));
     ALEFSI_PETSC(KSPSetOperators(ksp_, mat_, mat_));
   }
   void setup() { ALEFSI_PETSC(KSPSetUp(ksp_)); }

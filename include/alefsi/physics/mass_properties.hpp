@@ -45,11 +45,10 @@ inline void check_length(Real x, const char* name) {
 }
 }  // namespace detail
 
-/// A disk: m = rho pi r^2, I = m r^2 / 2.
+/// A disk: m = rho pi r^2, I = m r^2 / 2 (disk_body's).
 inline MassProperties2D mass_properties(const Circle& c, Real density) {
-  detail::check_density(density), detail::check_length(c.radius, "radius");
-  const Real m = density * std::numbers::pi * c.radius * c.radius;
-  return {m, c.centre, 0.5 * m * c.radius * c.radius};
+  const RigidBody2D b = disk_body(c.tag, c.centre, c.radius, density);
+  return {b.mass, b.centre, b.inertia};
 }
 
 /// An elliptic disk: m = rho pi a b, I = m (a^2 + b^2) / 4 (independent of its angle).
@@ -83,11 +82,10 @@ inline MassProperties2D mass_properties(const Polyline& p, Real density) {
   return {m, o + g, m * (j - g.squaredNorm())};  // parallel axes: about the centroid
 }
 
-/// A ball: m = rho 4/3 pi r^3, I = 2/5 m r^2 times the identity.
+/// A ball: m = rho 4/3 pi r^3, I = 2/5 m r^2 times the identity (sphere_body's).
 inline MassProperties3D sphere_mass_properties(const Vec<3>& centre, Real radius, Real density) {
-  detail::check_density(density), detail::check_length(radius, "radius");
-  const Real m = density * 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
-  return {m, centre, Mat<3>::Identity() * (0.4 * m * radius * radius)};
+  const RigidBody3D b = sphere_body(0, centre, radius, density);
+  return {b.mass, b.centre, b.inertia};
 }
 
 /// An ellipsoid with semi-axes (a, b, c) along the body's x, y, z axes: m = rho 4/3 pi a b c,

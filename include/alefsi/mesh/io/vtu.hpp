@@ -546,13 +546,7 @@ class PvdWriter {
     const std::string name = step_name() + ".vtu";
     const std::filesystem::path vtu = dir_ / name;
     write_vtu(vtu, mesh, fields, order, edge_midpoints);
-    steps_.push_back({time, (std::filesystem::path(stem_) / name).generic_string()});
-    try {
-      write_collection();
-    } catch (...) {
-      steps_.pop_back();
-      throw;
-    }
+    list(time, name, [&] { write_collection(); });
     return vtu;
   }
   template <int D>
@@ -582,8 +576,7 @@ class PvdWriter {
         [&] { write_vtu_piece(dir_ / source(piece.part), mesh, piece.cells, fields, order, edge_midpoints); },
         piece.all, elsewhere + "another process could not write its piece");
     const std::filesystem::path pvtu = dir_ / (step + ".pvtu");
-    steps_.push_back({time, (std::filesystem::path(stem_) / (step + ".pvtu")).generic_string()});
-    try {
+    list(time, step + ".pvtu", [&] {
       detail::together(
           [&] {
             if (piece.part != 0) return;
@@ -598,10 +591,7 @@ class PvdWriter {
             write_collection();
           },
           piece.all, elsewhere + "part 0 could not write the step's parallel file or the collection");
-    } catch (...) {
-      steps_.pop_back();
-      throw;
-    }
+    });
     return pvtu;
   }
   template <int D>
@@ -628,6 +618,18 @@ class PvdWriter {
     if (!steps_.empty())
       ALEFSI_CHECK_ARG(time > steps_.back().time, "time", "must exceed the previous step's time ",
                        detail::format_real(steps_.back().time), ", got ", detail::format_real(time));
+  }
+  /// Lists step `file` (in the steps' folder) at `time` and runs `write`, which writes the
+  /// collection; if it throws, the step is not listed.
+  template <class Write>
+  void list(Real time, const std::string& file, const Write& write) {
+    steps_.push_back({time, (std::filesystem::path(stem_) / file).generic_string()});
+    try {
+      write();
+    } catch (...) {
+      steps_.pop_back();
+      throw;
+    }
   }
   /// "<stem>_NNNNNN" for the next step.
   std::string step_name() const { return stem_ + "_" + detail::zero_padded(long(steps_.size()), 6); }

@@ -8,7 +8,7 @@
 #include "alefsi/sim/checkpoint.hpp"
 #include "alefsi/sim/config.hpp"
 #include "alefsi/sim/contact.hpp"
-#include "alefsi/sim/contact2d.hpp"
+#include "alefsi/sim/collision_contact.hpp"
 #include "alefsi/sim/discretisation.hpp"
 #include "alefsi/sim/driver.hpp"
 #include "alefsi/sim/flow_state.hpp"

@@ -17,10 +17,11 @@
 #include "alefsi/mesh/io/gmsh.hpp"
 #include "alefsi/mesh/generate/mesher2d.hpp"
 #include "alefsi/mesh/generate/structured.hpp"
+#include "alefsi/physics/mass_properties.hpp"
 #include "alefsi/physics/stokes.hpp"
 #include "alefsi/scenes/oscillating_cylinder.hpp"
 #include "alefsi/sim/body_system.hpp"
-#include "alefsi/sim/contact2d.hpp"
+#include "alefsi/sim/collision_contact.hpp"
 #include "alefsi/sim/flow_state.hpp"
 #include "alefsi/sim/newton.hpp"
 #include "alefsi/sim/remesher2d.hpp"
@@ -151,6 +152,55 @@ TEST_CASE("body rows: the body blocks of add_rows match finite differences (2D w
     CHECK((states[0].contact + states[1].contact).norm() <= 1e-14 * states[0].contact.norm());
     CHECK(states[0].contact.norm() > 0);
   }
+  SECTION("2D: two squares, a corner near an edge away from the centre (a contact moment)") {
+    // square A = [0.5, 0.9] x [0.8, 1.2]; square B of the same size about (1.2, 1.1) turned by
+    // 30 degrees: its leftmost corner (0.927, 1.173) is 0.027 from A's right edge, 0.17 above
+    // A's centre: the force on A pushes it to the left at a point above its centre
+    auto square = [](const Vec<2>& c, Real angle, int tag) {
+      Polyline p{.points = {}, .tag = tag};
+      const Eigen::Rotation2D<Real> rot(angle);
+      for (const Vec<2>& v : {Vec<2>(-0.2, -0.2), Vec<2>(0.2, -0.2), Vec<2>(0.2, 0.2), Vec<2>(-0.2, 0.2)})
+        p.points.push_back(c + rot * v);
+      return p;
+    };
+    const std::vector<Polyline> squares = {square(Vec<2>(0.7, 1), 0, 5), square(Vec<2>(1.2, 1.1), std::numbers::pi / 6, 6)};
+    const Mesh<2> mesh = generate_mesh({Polyline{{Vec<2>(0, 0), Vec<2>(2, 0), Vec<2>(2, 2), Vec<2>(0, 2)}, 1},
+                                        {squares[0], squares[1]}},
+                                       {.size = [](const Vec<2>&) { return 0.05; }});
+    MixedSpace<2, TaylorHood> space(mesh);
+    BodySystem<2, RigidBodyTraits<2>> bodies;
+    std::vector<BodyState<2, RigidBodyTraits<2>>> states;
+    for (const auto& p : squares) bodies.add(free_body(p.tag, mass_properties(p, 1.5)), mesh, 0.0, states);
+    states[0].velocity.fill(Vec<3>(0.4, 0.1, 0.3));
+    states[1].velocity.fill(Vec<3>(-0.5, 0.2, -0.1));
+    bodies.attach(mesh);
+    const StepCoefficients c = step_coefficients<BDF2_BDF2E>(0.01, TimeHistory{});
+    NodeVelocities<2> nodes;
+    bodies.mesh_velocity_data(states, mesh.coordinates(), c.extrapolation, 0.01, nodes);
+    std::vector<Vec<2>> x = mesh.coordinates();
+    bodies.advance(states, c, x);
+    CollisionContact2D contact(CollisionOptions{.range = 0.5, .spring_range = 0.05, .spring_force = 3});
+    contact.set_walls(mesh, bodies.tags());
+    const auto placed = bodies.contact_bodies(states, -1);
+    REQUIRE(contact.find(placed, 0.01) == 1);
+    const auto& k = contact.contacts()[0];
+    CHECK(k.gap > 0.01);  // 0.0268 less the step's approach (about 0.009)
+    CHECK(k.gap < 0.0268);
+    CHECK(std::abs(k.normal[0]) > 0.99);     // across A's right edge
+    check_body_jacobian<2>(space, bodies, states, contact, c, Vec<2>(0, -9.81));
+    // the forces cancel, and so do their moments about the origin (the same point of action)
+    auto moment = [](const Vec<2>& x0, const Vec<3>& G) { return G[2] + x0[0] * G[1] - x0[1] * G[0]; };
+    CHECK((states[0].contact + states[1].contact).head<2>().norm() <= 1e-14 * states[0].contact.norm());
+    CHECK(std::abs(moment(placed[0].centre, states[0].contact) + moment(placed[1].centre, states[1].contact)) <=
+          1e-14 * states[0].contact.norm());
+    // the moment on A is its arm (0.17 above the centre, 0.21 to the right) times the force:
+    // pushed to the left above its centre, A turns anticlockwise
+    const Vec<2> F = states[0].contact.head<2>();
+    CHECK(F[0] < 0);
+    CHECK(std::abs(k.arm_k[1] - 0.173) < 0.01);
+    CHECK(states[0].contact[2] == Approx(k.arm_k[0] * F[1] - k.arm_k[1] * F[0]).epsilon(1e-14));
+    CHECK(states[0].contact[2] > 0);
+  }
   SECTION("3D: a free anisotropic body turning off its principal axes") {
     const Mesh<3> mesh = read_gmsh<3>(std::string(ALEFSI_TEST_DATA_DIR) + "/gmsh/sphere_in_box3d.msh").mesh;
     MixedSpace<3, P1P1Gls> space(mesh);
@@ -241,7 +291,10 @@ TEST_CASE("CollisionContact2D: eq. (24) + spring through the seam, momentum bala
   const std::vector<Vec<2>> v = {Vec<2>(0, 3), Vec<2>(0, -2)};
   std::vector<Vec<2>> F(2, Vec<2>::Zero());
   int visits = 0;
-  model.forces(v, [&](int k, const Vec<2>& f, const Mat<2>&) { F[k] += f, ++visits; });
+  model.forces(v, [&](int k, const Vec<2>& f, const Mat<2>&, const Vec<2>& arm) {
+    F[k] += f, ++visits;
+    CHECK(arm.norm() == 0.0);  // disks: through the centres
+  });
   CHECK(visits == 2);
   const Real s = 1 - d / 0.02;
   const Real expected = mu * std::pow(4 * R / d, 1.5) * 5.0 + 7 * s * s;
@@ -281,6 +334,66 @@ TEST_CASE("CollisionContact2D: eq. (24) + spring through the seam, momentum bala
   geometry.set_walls(box, {});
   CHECK(geometry.find(b, mu) == 0);
   CHECK(NoContact<3>().gaps(std::vector<ContactBody<3>>(2))[1] == std::numeric_limits<Real>::infinity());
+}
+
+TEST_CASE("CollisionContact<3>: spheres in a box through the seam, momentum balance, overlaps, gaps and times",
+          "[sim][collision][quick]") {
+  const Real R = 0.5, mu = 0.3, d = 0.01;
+  const Mesh<3> box = box_mesh(3, 3, 4, Vec<3>::Zero(), Vec<3>(4, 4, 6));
+  CollisionContact<3> model({.range = 0.1, .spring_range = 0.03, .spring_force = 2});
+  model.set_walls(box, {});
+  auto sphere = [](const Vec<3>& c, Real r, const Vec<3>& v) {
+    ContactBody<3> b;
+    b.centre = c, b.velocity = v, b.radius = b.r_in = b.r_out = r;
+    return b;
+  };
+  // two spheres nearly touching along a diagonal, the lower one near the floor
+  const Vec<3> n = Vec<3>(1, 1, 2).normalized();
+  std::vector<ContactBody<3>> b = {sphere(Vec<3>(1.5, 1.5, R + 0.02), R, Vec<3>::Zero()),
+                                   sphere(Vec<3>(1.5, 1.5, R + 0.02) + (2 * R + d) * n, R, Vec<3>::Zero())};
+  REQUIRE(model.find(b, mu) == 2);  // the pair and the floor
+  const std::vector<Vec<3>> v = {Vec<3>(0.1, 0, -0.4), Vec<3>(-0.2, 0.1, -1)};
+  std::vector<Vec<3>> F(2, Vec<3>::Zero());
+  std::vector<Mat<3>> dF(2, Mat<3>::Zero());
+  model.forces(v, [&](int k, const Vec<3>& f, const Mat<3>& df, const Vec<3>& arm) {
+    F[k] += f, dF[k] += df;
+    CHECK(arm.norm() == 0.0);  // spheres: through the centres
+  });
+  const Real s_pair = 1 - d / 0.03, s_floor = 1 - 0.02 / 0.03;
+  const Real pair = mu * std::pow(4 * R / d, 1.5) * (v[1] - v[0]).norm() + 2 * s_pair * s_pair;
+  const Real floor = mu * std::pow(4 * R / 0.02, 1.5) * v[0].norm() + 2 * s_floor * s_floor;
+  CHECK((F[1] - pair * n).norm() < 1e-12 * pair);               // the upper sphere: pushed along n
+  CHECK((F[0] + pair * n - floor * Vec<3>::UnitZ()).norm() < 1e-12 * pair);  // the lower: -n, and up from the floor
+  CHECK((F[0] + F[1] - floor * Vec<3>::UnitZ()).norm() < 1e-12 * pair);      // action = reaction between them
+  // each body's dF/dV against finite differences of the total force on it
+  const Real h = 1e-6;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 3; ++j) {
+      auto vp = v, vm = v;
+      vp[k][j] += h, vm[k][j] -= h;
+      Vec<3> fp = Vec<3>::Zero(), fm = Vec<3>::Zero();
+      model.forces(vp, [&](int i, const Vec<3>& f, const Mat<3>&, const Vec<3>&) { if (i == k) fp += f; });
+      model.forces(vm, [&](int i, const Vec<3>& f, const Mat<3>&, const Vec<3>&) { if (i == k) fm += f; });
+      for (int i = 0; i < 3; ++i) CHECK(dF[k](i, j) == Approx((fp[i] - fm[i]) / (2 * h)).epsilon(1e-6).margin(1e-5));
+    }
+  // overlaps, gaps, and times to contact
+  CHECK(model.overlaps(b).empty());
+  b[1].centre = b[0].centre + (2 * R - 1e-3) * n;
+  const auto o = model.overlaps(b);
+  REQUIRE(o.size() == 1);
+  CHECK(o[0].gap == Approx(-1e-3).epsilon(1e-9));
+  b = {sphere(Vec<3>(2, 2, 1), R, Vec<3>(0, 0, -2)), sphere(Vec<3>(2, 2, 3), R, Vec<3>(0, 0, -4))};
+  const auto g = model.gaps(b);
+  CHECK(g[0] == Approx(1 - R).epsilon(1e-12));        // the floor
+  CHECK(g[1] == Approx(2 - 2 * R).epsilon(1e-12));    // the other sphere (the side walls are at 2 - R)
+  const auto t = model.times_to_contact(b);
+  CHECK(t[0] == Approx((1 - R) / 2).epsilon(1e-12));  // the floor
+  CHECK(t[1] == Approx((2 - 2 * R) / 2).epsilon(1e-12));  // the other sphere (closing at 2) before the floor (2.5 / 4)
+  // geometry only: no forces, but the gaps
+  CollisionContact<3> geometry;
+  geometry.set_walls(box, {});
+  CHECK(geometry.find(b, mu) == 0);
+  CHECK(geometry.gaps(b)[0] == Approx(1 - R).epsilon(1e-12));
 }
 
 // ---- the remesher ----------------------------------------------------------------------------

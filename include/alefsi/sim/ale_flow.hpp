@@ -47,7 +47,7 @@
 #include "alefsi/sim/checkpoint.hpp"
 #include "alefsi/sim/config.hpp"
 #include "alefsi/sim/contact.hpp"
-#include "alefsi/sim/contact2d.hpp"
+#include "alefsi/sim/collision_contact.hpp"
 #include "alefsi/sim/discretisation.hpp"
 #include "alefsi/sim/flow_state.hpp"
 #include "alefsi/sim/kinematics.hpp"
@@ -257,7 +257,9 @@ class AleFlow {
   /// quantity; BodySystem::driven_loads).
   BodyVelocity body_hydrodynamic_load(std::size_t k) const { return state_.bodies.at(k).load; }
   /// Contact force on body k in the last step.
-  Vec<D> body_collision_force(std::size_t k) const { return state_.bodies.at(k).contact; }
+  Vec<D> body_collision_force(std::size_t k) const { return state_.bodies.at(k).contact.template head<D>(); }
+  /// The contact force and its moment about the centre (2D: F1, F2, M3; 3D: F, M) in the last step.
+  BodyVelocity body_collision_load(std::size_t k) const { return state_.bodies.at(k).contact; }
   /// Per body, the gap to the nearest other body or wall at t^n (the contact model's).
   std::vector<Real> body_gaps() const { return contact_->gaps(bodies_.contact_bodies(state_.bodies, 0)); }
   /// Per body, the smallest gap / closing speed to a body or wall it approaches (infinity: none).

@@ -48,32 +48,6 @@
 
 namespace alefsi {
 
-namespace detail {
-/// The point of a boundary facet (2D: segment, 3D: triangle) closest to p.
-inline Vec<2> closest_on_facet(const Vec<2>& p, const std::array<Vec<2>, 2>& s) { return closest_on_segment(p, s); }
-inline Vec<3> closest_on_facet(const Vec<3>& p, const std::array<Vec<3>, 3>& t) {
-  // Ericson, Real-Time Collision Detection, 5.1.5: Voronoi regions of the triangle
-  const Vec<3> &a = t[0], &b = t[1], &c = t[2];
-  const Vec<3> ab = b - a, ac = c - a, ap = p - a;
-  const Real d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const Vec<3> bp = p - b;
-  const Real d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const Real vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
-  const Vec<3> cp = p - c;
-  const Real d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const Real vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
-  const Real va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
-  const Real den = 1 / (va + vb + vc);
-  return a + ab * (vb * den) + ac * (vc * den);
-}
-}  // namespace detail
-
 template <int D, RigidBodyModel M>
 class BodySystem {
   static_assert(M::dim == D, "the rigid-body model's dimension must be the flow's");
@@ -332,7 +306,7 @@ class BodySystem {
     for (std::size_t k = 0; k < entries_.size(); ++k) {
       const auto& e = entries_[k];
       State& s = states[k];
-      s.contact = Vec<D>::Zero();
+      s.contact = Velocity::Zero();
       if (!M::is_free(e.data)) continue;
       const Index row = cons.extra_unknown(e.extra);
       const Velocity Z = u.template segment<n_dof>(row);
@@ -348,14 +322,23 @@ class BodySystem {
       v[k] = M::is_free(entries_[k].data)
                  ? Vec<D>(u.template segment<D>(cons.extra_unknown(entries_[k].extra)))
                  : Vec<D>(M::prescribed_velocity(entries_[k].data, t1).template head<D>());
-    contact.forces(v, [&](int b, const Vec<D>& F, const Mat<D>& dF) {
-      states[b].contact += F;
+    // a force F at `arm` from the centre is the load H(arm)^T F (force and moment arm x F)
+    contact.forces(v, [&](int b, const Vec<D>& F, const Mat<D>& dF, const Vec<D>& arm) {
+      const bool moment = arm.squaredNorm() > 0;  // else G = (F, 0) exactly
+      const auto H = M::rows(arm);
+      Velocity G = Velocity::Zero();
+      for (int d = 0; d < D; ++d) G += F[d] * H[d];
+      states[b].contact += G;
       if (!M::is_free(entries_[b].data)) return;
       const Index row = cons.extra_unknown(entries_[b].extra);
-      r.template segment<D>(row) -= F;
+      r.template segment<n_dof>(row) -= G;
       if (!here(std::size_t(b))) return;
-      for (int i = 0; i < D; ++i)
-        for (int j = 0; j < D; ++j) J.coeffRef(row + i, row + j) -= dF(i, j);
+      for (int i = 0; i < (moment ? n_dof : D); ++i)
+        for (int j = 0; j < D; ++j) {
+          Real dG = 0;  // d G_i / d V_j = sum_d H[d]_i dF(d, j)
+          for (int d = 0; d < D; ++d) dG += H[d][i] * dF(d, j);
+          J.coeffRef(row + i, row + j) -= dG;
+        }
     });
   }
 
@@ -386,7 +369,7 @@ class BodySystem {
       const Velocity Zn1 = next_velocity(k, cons, u, t1);
       if (free) {
         s.load = inertia(e, s, c, Zn1) - weight(e, gravity) - M::external_load(e.data);
-        s.load.template head<D>() -= s.contact;
+        s.load -= s.contact;
       }
       s.velocity.push(Zn1);
       s.centre.push(e.xg_next);

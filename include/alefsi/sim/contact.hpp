@@ -12,16 +12,16 @@
 ///     and `times_to_contact(bodies)`: gap over closing speed (the adaptive driver's event);
 ///   - `find(bodies, mu)` then `forces(velocities, visit)`: the contacts of the step being
 ///     solved, from the bodies placed at t^{n+1}, and their forces at the velocities of the
-///     current Newton iterate. For each contact, `visit(body, F, dF)` is called on each free or
-///     driven body it acts on with the force F on that body and dF = dF/dV of that body's own
-///     translational velocity (the coupling between two bodies' rows is lagged: it is not in
-///     the pattern). The flow adds -F to the body's force rows and -dF to its Jacobian block.
-/// The force acts at the centre of mass (no torque) in the models here; a model for non-convex
-/// or non-spherical shapes would add the torque of the contact point (issue 16).
+///     current Newton iterate. For each contact, `visit(body, F, dF, arm)` is called on each
+///     free or driven body it acts on with the force F on that body, dF = dF/dV of that body's
+///     own translational velocity (the coupling between two bodies' rows is lagged: it is not
+///     in the pattern) and `arm`, from the body's centre to the point where F acts (0: through
+///     the centre). The flow subtracts the force and its moment arm x F from the body's rows,
+///     and their derivatives from its Jacobian block.
 ///
-/// Models: `NoContact<D>` (no forces, no gaps, no overlap checks: what 3D has until a 3D model
-/// exists) and `CollisionContact2D` (sim/contact2d.hpp: the paper's eq. (24) made repulsive, the
-/// spring safeguard, exact disk distances). Adding a model: derive from ContactModel<D>,
+/// Models: `NoContact<D>` (no forces, no gaps, no overlap checks) and `CollisionContact<D>`
+/// (sim/collision_contact.hpp, 2D and 3D: the paper's eq. (24) made repulsive, the spring
+/// safeguard, exact disk and sphere distances). Adding a model: derive from ContactModel<D>,
 /// implement the five functions, and hand it to `AleFlow::set_contact_model`
 /// (docs/architecture.md, "How to add a contact model").
 #include <array>
@@ -57,7 +57,7 @@ struct ContactOverlap {
 template <int D>
 class ContactModel {
  public:
-  using Visit = std::function<void(int body, const Vec<D>& force, const Mat<D>& dforce)>;
+  using Visit = std::function<void(int body, const Vec<D>& force, const Mat<D>& dforce, const Vec<D>& arm)>;
   virtual ~ContactModel() = default;
   /// The fixed walls: the boundary facets of `mesh` whose tag is none of `body_tags`.
   virtual void set_walls(const Mesh<D>& mesh, const std::vector<int>& body_tags) = 0;
@@ -92,14 +92,9 @@ class NoContact final : public ContactModel<D> {
 
 /// The contact models a flow of dimension D starts with: `geometry()` (no forces; gaps and
 /// overlap checks where the dimension has them) and, where the dimension has one,
-/// `collisions(CollisionOptions)` (what `AleFlow::set_collisions` installs). 2D: sim/contact2d.hpp.
+/// `collisions(CollisionOptions)` (what `AleFlow::set_collisions` installs); 2D and 3D:
+/// sim/collision_contact.hpp.
 template <int D>
 struct DefaultContact;
-
-/// 3D: no contact model yet (issue 15 adds sphere-sphere and sphere-plane).
-template <>
-struct DefaultContact<3> {
-  static std::unique_ptr<ContactModel<3>> geometry() { return std::make_unique<NoContact<3>>(); }
-};
 
 }  // namespace alefsi

@@ -11,7 +11,8 @@
 ///             the pressure at the scheme's level n - 1 + theta)
 ///   V         mesh velocity at t^n (per node)
 ///   bodies[b] centre, orientation and velocity Z per level, the last step's hydrodynamic load
-///             and contact force, and the surface node offsets (body frame of the rigid-body
+///             and contact force and moment (read back also from files that hold only the force,
+///             written before contact moments), and the surface node offsets (body frame of the rigid-body
 ///             model, one per surface node in the order of the body's surface node list)
 ///   stats     steps taken, remeshes, history restarts (and the last step's active contacts,
 ///             not written)
@@ -45,7 +46,7 @@ struct BodyState {
   Levels<Orientation> orientation;
   Levels<Velocity> velocity;  ///< Z
   Velocity load = Velocity::Zero();  ///< hydrodynamic force and torque over the last step
-  Vec<D> contact = Vec<D>::Zero();   ///< contact force in the last step
+  Velocity contact = Velocity::Zero();  ///< contact force and moment in the last step
   std::vector<Vec<D>> surface;       ///< surface node offsets from the centre, model frame
 };
 
@@ -243,10 +244,13 @@ void read_state(CheckpointReader& r, FlowState<D, M>& s, const std::vector<int>&
     const auto contact = r.get_vector<Real>("body contact");
     const std::size_t n_surface = body.surface.size();
     body.surface = detail::unflatten<D>(r.get_vector<Real>("body surface"));
-    if (load.size() != std::size_t(M::n_dof) || contact.size() != std::size_t(D) || body.surface.size() != n_surface)
+    // the contact: force and moment, or (checkpoints written before contact moments) the force
+    if (load.size() != std::size_t(M::n_dof) || (contact.size() != std::size_t(D) && contact.size() != std::size_t(M::n_dof)) ||
+        body.surface.size() != n_surface)
       r.fail("bad body record");
     for (int c = 0; c < M::n_dof; ++c) body.load[c] = load[c];
-    for (int c = 0; c < D; ++c) body.contact[c] = contact[c];
+    body.contact.setZero();
+    for (std::size_t c = 0; c < contact.size(); ++c) body.contact[Index(c)] = contact[c];
   }
 }
 

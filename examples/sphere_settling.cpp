@@ -9,9 +9,15 @@
 // concentric-spheres wall factor K(a / b) (Haberman & Sayre 1958), U = 4.925 / mu cm/s. It
 // drifts a little below the centre meanwhile (0.05 cm by t = 0.1 s), which changes the drag
 // by a small amount.
+// With --start-z -1.55 --contact --mu 1 --t-end 0.3 it starts 0.2 cm above the bottom, lands on
+// the container's wall through the collision model (eq. 24 + spring) and settles at the gap where
+// the spring carries its buoyant weight, rho (1 - sqrt(W' / F_0)) = 0.025 cm (0.0249 at
+// t = 0.3 s, 113 adaptive steps, 61 s). It keeps sliding slowly (0.02 cm/s): the wall is the
+// container's triangles, and the nearest one's normal is a few degrees off the vertical.
 //
 // How to run: ./sphere_settling [--layers 2] [--grading 2] [--dt 0.005] [--t-end 0.1]
-//             [--mu 10] [--output DIR] [--vtu-every 0] [--checkpoint-every 0] [--restart]
+//             [--mu 10] [--start-z 0] [--contact] [--output DIR] [--vtu-every 0]
+//             [--checkpoint-every 0] [--restart]
 //             (`--help` lists the options). --restart continues from DIR/checkpoint.bin (with
 //             the same options; on any number of ranks).
 // What it prints: the mesh and unknowns, a progress line every 10 steps, then the sphere's
@@ -59,7 +65,8 @@ struct Settings {
   scenes::SettlingSphere scene;
   Real dt = 0.005, t_end = 0.1;
   int vtu_every = 0, checkpoint_every = 0;
-  bool restart = false;
+  Real start_z = 0;
+  bool restart = false, contact = false;
   std::filesystem::path output = "sphere_settling_out";
 };
 
@@ -68,6 +75,8 @@ bool parse(int argc, char** argv, Settings& o) {
   opt.add("layers", o.scene.layers, "cell layers across the gap (336 layers^3 tetrahedra)")
       .add("grading", o.scene.grading, "pull of the layers towards the sphere (1: none)")
       .add("mu", o.scene.mu, "viscosity (P)")
+      .add("start-z", o.start_z, "the sphere's height at t = 0 (cm; the container's centre is 0)")
+      .flag("contact", o.contact, "collisions with the container (eq. 24 + spring)")
       .add("dt", o.dt, "time step (s)")
       .add("t-end", o.t_end, "end time (s)")
       .add("output", o.output, "folder for bodies.csv, VTU and checkpoints")
@@ -96,10 +105,12 @@ int settling_main(int argc, char** argv) try {
   if (!parse(argc, argv, o)) return 0;
   const auto wall0 = std::chrono::steady_clock::now();
   const Real cpu0 = cpu_seconds();
+  o.scene.start = alefsi::Vec<3>(0, 0, o.start_z);
   const scenes::SettlingSphere& scene = o.scene;
   const auto checkpoint = o.output / "checkpoint.bin";
   Flow flow(o.restart ? read_checkpoint_mesh<3>(checkpoint) : scene.mesh(), scene.flow_options());
   scene.configure(flow);
+  if (o.contact) flow.set_collisions(scene.collisions());
   if (o.restart) flow.load_checkpoint(checkpoint);
   std::cout << "sphere_settling (" << Solver::name << "): " << flow.mesh().n_cells() << " tetrahedra, "
             << flow.space().n_field() + Flow::body_dofs << " unknowns; a = " << scene.a << ", b = " << scene.b
@@ -115,7 +126,11 @@ int settling_main(int argc, char** argv) try {
   std::cout << std::setprecision(8) << "t = " << flow.time() << ": depth " << depth << " cm, velocity (" << Z[0]
             << ", " << Z[1] << ", " << Z[2] << ") cm/s, spin |w| = " << std::setprecision(2) << Z.tail<3>().norm()
             << "\n  -v_z / U_terminal = " << std::setprecision(6) << -Z[2] / U << " (U = " << U
-            << " cm/s: creeping flow, concentric spheres, K = " << scene.wall_factor() << ")\n"
+            << " cm/s: creeping flow, concentric spheres, K = " << scene.wall_factor() << ")\n";
+  if (o.contact)
+    std::cout << "  gap " << std::setprecision(6) << flow.body_gaps()[0] << " cm, at rest it would be "
+              << scene.resting_gap() << " cm (the spring carries the buoyant weight)\n";
+  std::cout
             << "  " << sum.steps << " steps, last solve " << flow.solver().iterations() << " iterations; wall "
             << std::setprecision(3)
             << std::chrono::duration<Real>(std::chrono::steady_clock::now() - wall0).count() << " s, CPU "

@@ -126,7 +126,6 @@ Vec<D> closest_on_segment(const Vec<D>& p, const Vec<D>& a, const Vec<D>& b) {
   const Real t = l2 > 0 ? std::clamp((p - a).dot(e) / l2, Real(0), Real(1)) : Real(0);
   return a + t * e;
 }
-inline Vec<2> closest_on_segment(const Vec<2>& p, const Segment2D& s) { return closest_on_segment<2>(p, s[0], s[1]); }
 
 /// The point of a facet (2D: segment, 3D: triangle) closest to p.
 inline Vec<2> closest_on_facet(const Vec<2>& p, const Facet<2>& s) { return closest_on_segment<2>(p, s[0], s[1]); }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "alefsi/mesh/adapt.hpp"
+#include "alefsi/mesh/generate/structured.hpp"
 
 using namespace alefsi;
 
@@ -66,12 +67,28 @@ Polyline channel_walls(double W, double H) {
 }
 
 /// Values of f at the P1 (degree 1) or P2 (degree 2) DOF points of a mesh (DofMap numbering).
-std::vector<double> interpolate(const Mesh<2>& m, int degree, const std::function<double(const Vec<2>&)>& f) {
+template <int D>
+std::vector<double> interpolate(const Mesh<D>& m, int degree, const std::function<double(const Vec<D>&)>& f) {
   std::vector<double> v;
   for (Index i = 0; i < m.n_nodes(); ++i) v.push_back(f(m.node(i)));
   if (degree == 2)
     for (Index e = 0; e < m.n_edges(); ++e) v.push_back(f(0.5 * (m.node(m.edge(e)[0]) + m.node(m.edge(e)[1]))));
   return v;
+}
+std::vector<double> interpolate(const Mesh<2>& m, int degree, const std::function<double(const Vec<2>&)>& f) {
+  return interpolate<2>(m, degree, f);
+}
+std::vector<double> interpolate(const Mesh<3>& m, int degree, const std::function<double(const Vec<3>&)>& f) {
+  return interpolate<3>(m, degree, f);
+}
+
+/// box_mesh of the unit cube moved by a smooth map onto itself (boundary fixed).
+Mesh<3> perturbed_cube(int n) {
+  Mesh<3> m = box_mesh(n, n, n);
+  std::vector<Vec<3>> x = m.coordinates();
+  for (auto& p : x) p += 0.05 * std::sin(pi * p[0]) * std::sin(pi * p[1]) * std::sin(pi * p[2]) * Vec<3>(1.0, -0.7, 0.4);
+  m.set_coordinates(x);
+  return m;
 }
 
 Mesh<2> square_mesh(double h) {
@@ -461,6 +478,130 @@ TEST_CASE("transfer: convergence at the interpolation order for a smooth field",
   }
 }
 
+// ---- 3D: tetrahedra ----------------------------------------------------------------------
+
+TEST_CASE("locate in 3D: bucket grid, walk with hint, nearest cell outside", "[mesh][adapt]") {
+  const Mesh<3> m = spherical_shell_mesh(0.5, 1.0, 2);  // a hole and a curved outside
+  const PointLocator<3> loc(m);
+  auto point = [&](Index c, const Vec<4>& l) {
+    Vec<3> p = Vec<3>::Zero();
+    for (int k = 0; k < 4; ++k) p += l[k] * m.node(m.cell(c)[k]);
+    return p;
+  };
+  for (int k = 0; k < 300; ++k) {  // points well inside the polyhedral shell
+    const double r = 0.56 + 0.38 * (k % 13) / 12.0, th = 0.1 + 2.9 * (k % 7) / 6.0, ph = 0.41 * k;
+    const Vec<3> x(r * std::sin(th) * std::cos(ph), r * std::sin(th) * std::sin(ph), r * std::cos(th));
+    Vec<4> l;
+    const Index c = loc.locate(x, &l);
+    REQUIRE(c >= 0);
+    CHECK((point(c, l) - x).norm() <= 1e-13);
+    CHECK(l.minCoeff() >= 0.0);
+    Vec<4> l2;
+    const Index c2 = loc.locate(x, &l2, (11 * k) % m.n_cells());  // walk from an arbitrary cell
+    CHECK((point(c2, l2) - x).norm() <= 1e-13);
+  }
+  // outside: the hole, beyond the outer sphere, far away; nearest cell against brute force
+  for (const Vec<3>& x : {Vec<3>(0, 0, 0), Vec<3>(0.1, 0.2, -0.1), Vec<3>(0.3, -0.9, 0.6), Vec<3>(-4, 3, 7)}) {
+    const PointLocation<3> L = loc.find(x);
+    REQUIRE(L.cell >= 0);
+    CHECK(L.distance > 0);
+    CHECK(L.lambda.minCoeff() >= 0.0);
+    CHECK(L.lambda.sum() == Approx(1.0));
+    CHECK((point(L.cell, L.lambda) - x).norm() == Approx(L.distance));
+    CHECK((point(L.cell, L.raw) - x).norm() <= 1e-12);  // the unclamped coordinates reproduce x
+    double best = 1e300;
+    for (Index c = 0; c < m.n_cells(); ++c) best = std::min(best, (point(c, detail::cell_closest_barycentric(m, c, x)) - x).norm());
+    CHECK(L.distance == Approx(best).epsilon(1e-12));
+  }
+  // the closest point of a tetrahedron: on a face, an edge, a vertex (unit corner tetrahedron)
+  const Vec<3> o(0, 0, 0), ex(1, 0, 0), ey(0, 1, 0), ez(0, 0, 1);
+  CHECK(detail::closest_barycentric(o, ex, ey, ez, Vec<3>(0.2, 0.3, -1)).isApprox(Vec<4>(0.5, 0.2, 0.3, 0)));
+  CHECK(detail::closest_barycentric(o, ex, ey, ez, Vec<3>(0.5, -1, -1)).isApprox(Vec<4>(0.5, 0.5, 0, 0)));
+  CHECK(detail::closest_barycentric(o, ex, ey, ez, Vec<3>(2, 2, 2)).isApprox(Vec<4>(0, 1, 1, 1) / 3));
+  CHECK(detail::closest_barycentric(o, ex, ey, ez, Vec<3>(-1, -2, -3)).isApprox(Vec<4>(1, 0, 0, 0)));
+}
+
+TEST_CASE("transfer in 3D: exact for affine (P1) and quadratic (P2) fields", "[mesh][adapt]") {
+  const Mesh<3> from = perturbed_cube(5);
+  const Mesh<3> to = box_mesh(7, 6, 4);
+  auto lin = [](const Vec<3>& x) { return 0.5 - 1.5 * x[0] + 2.5 * x[1] - 0.75 * x[2]; };
+  auto quad = [](const Vec<3>& x) {
+    return 1 + x[0] - 2 * x[1] + x[2] + 3 * x[0] * x[0] - x[0] * x[1] + 2 * x[1] * x[1] - x[2] * x[2] + 1.5 * x[1] * x[2] -
+           0.5 * x[0] * x[2];
+  };
+  const FieldTransfer<3> T1(from, to, 1);
+  CHECK(T1.n_outside() == 0);
+  const auto v1 = T1.apply(interpolate(from, 1, lin));
+  const auto e1 = interpolate(to, 1, lin);
+  for (std::size_t i = 0; i < v1.size(); ++i) CHECK(std::abs(v1[i] - e1[i]) <= 1e-12);
+  const FieldTransfer<3> T2(from, to, 2);
+  const auto v2 = T2.apply(interpolate(from, 2, quad));
+  const auto e2 = interpolate(to, 2, quad);
+  REQUIRE(v2.size() == std::size_t(to.n_nodes() + to.n_edges()));
+  double worst = 0;
+  for (std::size_t i = 0; i < v2.size(); ++i) worst = std::max(worst, std::abs(v2[i] - e2[i]));
+  CHECK(worst <= 1e-12);
+  // three interleaved components (a velocity): each the same as alone
+  const auto sq = interpolate(from, 2, quad), sl = interpolate(from, 2, lin);
+  std::vector<double> inter(3 * sq.size());
+  for (std::size_t i = 0; i < sq.size(); ++i) inter[3 * i] = sq[i], inter[3 * i + 1] = sl[i], inter[3 * i + 2] = -sq[i];
+  const auto both = T2.apply(inter, 3);
+  const auto e2l = interpolate(to, 2, lin);
+  for (std::size_t i = 0; i < e2.size(); ++i) {
+    CHECK(both[3 * i] == v2[i]);
+    CHECK(std::abs(both[3 * i + 1] - e2l[i]) <= 1e-12);
+    CHECK(both[3 * i + 2] == -v2[i]);
+  }
+}
+
+TEST_CASE("transfer in 3D: a spherical shell's new boundary points, clamped or extrapolated", "[mesh][adapt]") {
+  // the finer shell's boundary nodes lie on the spheres, outside the coarse one's polyhedra
+  const Mesh<3> from = spherical_shell_mesh(0.5, 1.0, 1), to = spherical_shell_mesh(0.5, 1.0, 2);
+  auto lin = [](const Vec<3>& x) { return 2.0 + 3.0 * x[0] - 1.0 * x[1] + 0.5 * x[2]; };
+  const double grad = std::sqrt(9.0 + 1.0 + 0.25);
+  const FieldTransfer<3> clamp(from, to, 1), extra(from, to, 1, {}, OutsidePolicy::extrapolate);
+  std::printf("3D outside points: %d of %d, max distance %.2e\n", clamp.n_outside(), to.n_nodes(), clamp.max_outside_distance());
+  CHECK(clamp.n_outside() > 0);
+  CHECK(clamp.n_outside() == extra.n_outside());
+  const auto src = interpolate(from, 1, lin);
+  const double lo = *std::min_element(src.begin(), src.end()), hi = *std::max_element(src.begin(), src.end());
+  const auto vc = clamp.apply(src), ve = extra.apply(src);
+  double err_c = 0;
+  for (Index i = 0; i < to.n_nodes(); ++i) {
+    const double exact = lin(to.node(i));
+    err_c = std::max(err_c, std::abs(vc[i] - exact));
+    CHECK(std::abs(ve[i] - exact) <= 1e-12);              // extrapolation: exact for the space
+    CHECK((vc[i] >= lo - 1e-12 && vc[i] <= hi + 1e-12));  // clamping: no overshoot
+  }
+  CHECK(err_c > 1e-8);
+  CHECK(err_c <= grad * clamp.max_outside_distance() + 1e-12);
+}
+
+TEST_CASE("transfer in 3D: convergence at the interpolation order for a smooth field", "[mesh][adapt]") {
+  auto f = [](const Vec<3>& x) { return std::sin(3 * x[0] + 1) * std::cos(2 * x[1]) * std::exp(x[2]); };
+  const Mesh<3> to = box_mesh(13, 11, 12);
+  for (int degree : {1, 2}) {
+    std::vector<double> emax, erms;
+    for (int n : {4, 8, 16}) {
+      const Mesh<3> from = perturbed_cube(n);
+      const auto v = FieldTransfer<3>(from, to, degree).apply(interpolate(from, degree, f));
+      const auto e = interpolate(to, degree, f);
+      double mx = 0, s2 = 0;
+      for (std::size_t i = 0; i < v.size(); ++i) mx = std::max(mx, std::abs(v[i] - e[i])), s2 += (v[i] - e[i]) * (v[i] - e[i]);
+      emax.push_back(mx), erms.push_back(std::sqrt(s2 / double(v.size())));
+    }
+    for (std::size_t k = 1; k < emax.size(); ++k) {
+      const double rmax = std::log2(emax[k - 1] / emax[k]), rrms = std::log2(erms[k - 1] / erms[k]);
+      std::printf("3D P%d transfer, h = 1/%d: max error %.3e (rate %.2f), rms %.3e (rate %.2f)\n", degree, 4 << k, emax[k],
+                  rmax, erms[k], rrms);
+      if (k + 1 == emax.size()) {  // the finest pair: the interpolation orders 2 and 3
+        CHECK(rmax >= degree + 1 - 0.25);
+        CHECK(rrms >= degree + 1 - 0.2);
+      }
+    }
+  }
+}
+
 TEST_CASE("adapt and transfer: bad input names the parameter", "[mesh][adapt]") {
   const Mesh<2> m = rectangle_mesh(4, 4);
   auto param_of = [](auto&& fn) {
@@ -505,4 +646,7 @@ TEST_CASE("adapt and transfer: bad input names the parameter", "[mesh][adapt]") 
   const PointLocator2D loc(m);
   CHECK(param_of([&] { loc.locate(Vec<2>(std::nan(""), 0.0)); }) == "x");
   CHECK(param_of([&] { loc.locate(Vec<2>(0.5, 0.5), nullptr, m.n_cells()); }) == "hint");
+  const Mesh<3> cube = box_mesh(2, 2, 2);
+  CHECK(param_of([&] { FieldTransfer<3>(cube, cube, 2, std::vector<Vec<3>>(3)); }) == "to_edge_points");
+  CHECK(param_of([&] { PointLocator<3>(cube).locate(Vec<3>(0.5, std::nan(""), 0.5)); }) == "x");
 }

@@ -1,7 +1,7 @@
 #pragma once
 /// \file mesh/adapt/locate.hpp
-/// Point location in a 2D triangle mesh: which cell contains x, and x's barycentric
-/// coordinates in it.
+/// Point location in a triangle (2D) or tetrahedron (3D) mesh: which cell contains x, and x's
+/// barycentric coordinates in it.
 ///
 /// Algorithm: a uniform bucket grid over the bounding box (about one bucket per cell;
 /// each cell is filed in every bucket its bounding box overlaps), plus an optional
@@ -15,6 +15,9 @@
 /// that cell closest to x (so they are >= 0 and sum to 1: "clamped"); `Location::distance`
 /// is then > 0 and `Location::raw` holds the unclamped (extrapolating) coordinates.
 ///
+/// In 3D the grid, the walk and the search outside are the same; the closest point of a
+/// tetrahedron is found on its faces (triangle, then edge, then vertex).
+///
 /// Cost: construction O(n_cells) time and memory. A query costs O(cells per bucket),
 /// O(1) for quasi-uniform meshes; graded meshes put more cells in the buckets of their
 /// fine regions, which a hint avoids: queries made in the order of a nearby mesh's nodes
@@ -23,7 +26,7 @@
 ///
 /// Barycentric coordinate i belongs to local vertex i of the cell (`mesh.cell(c)[i]`).
 ///
-///     alefsi::PointLocator2D loc(mesh);
+///     alefsi::PointLocator2D loc(mesh);                  // PointLocator<3> for tetrahedra
 ///     Vec<3> lambda;
 ///     Index c = loc.locate(Vec<2>(0.3, 0.4), &lambda);   // cell, barycentrics
 #include <algorithm>
@@ -38,13 +41,15 @@
 
 namespace alefsi {
 
-/// Result of a point location.
-struct Location {
+/// Result of a point location (barycentric coordinates: D + 1 of them).
+template <int D>
+struct PointLocation {
   Index cell = -1;          ///< containing (or nearest) cell
-  Vec<3> lambda;            ///< barycentric coordinates in `cell`, clamped to the cell
-  Vec<3> raw;               ///< unclamped barycentric coordinates (== lambda inside)
+  Vec<D + 1> lambda;        ///< barycentric coordinates in `cell`, clamped to the cell
+  Vec<D + 1> raw;           ///< unclamped barycentric coordinates (== lambda inside)
   Real distance = 0;        ///< 0 inside the mesh, else distance from x to `cell`
 };
+using Location = PointLocation<2>;
 
 namespace detail {
 
@@ -54,6 +59,15 @@ inline Vec<3> barycentric(const Vec<2>& a, const Vec<2>& b, const Vec<2>& c, con
   const Real l1 = ((x[0] - a[0]) * (c[1] - a[1]) - (x[1] - a[1]) * (c[0] - a[0])) / det;
   const Real l2 = ((b[0] - a[0]) * (x[1] - a[1]) - (b[1] - a[1]) * (x[0] - a[0])) / det;
   return Vec<3>(1 - l1 - l2, l1, l2);
+}
+
+/// Barycentric coordinates of x in tetrahedron (a, b, c, d) (any orientation, non-degenerate):
+/// ratios of signed volumes.
+inline Vec<4> barycentric(const Vec<3>& a, const Vec<3>& b, const Vec<3>& c, const Vec<3>& d, const Vec<3>& x) {
+  const Vec<3> ab = b - a, ac = c - a, ad = d - a, ax = x - a;
+  const Real det = ab.dot(ac.cross(ad));
+  const Real l1 = ax.dot(ac.cross(ad)) / det, l2 = ab.dot(ax.cross(ad)) / det, l3 = ab.dot(ac.cross(ax)) / det;
+  return Vec<4>(1 - l1 - l2 - l3, l1, l2, l3);
 }
 
 /// Barycentric coordinates of the point of triangle (a, b, c) closest to x.
@@ -79,64 +93,135 @@ inline Vec<3> closest_barycentric(const Vec<2>& a, const Vec<2>& b, const Vec<2>
   return out;
 }
 
+/// Barycentric coordinates (in a, b, c) of the point of the 3D triangle (a, b, c) closest to x:
+/// the projection onto its plane if that is inside, else the best of its three edges.
+inline Vec<3> closest_barycentric(const Vec<3>& a, const Vec<3>& b, const Vec<3>& c, const Vec<3>& x) {
+  const Vec<3> e1 = b - a, e2 = c - a, r = x - a;
+  const Real g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2), r1 = r.dot(e1), r2 = r.dot(e2);
+  const Real det = g11 * g22 - g12 * g12;
+  const Real s = (g22 * r1 - g12 * r2) / det, t = (g11 * r2 - g12 * r1) / det;
+  if (s >= 0 && t >= 0 && s + t <= 1) return Vec<3>(1 - s - t, s, t);
+  const std::array<const Vec<3>*, 3> p{&a, &b, &c};
+  Real best = std::numeric_limits<Real>::infinity();
+  Vec<3> out = Vec<3>::Zero();
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    const Vec<3> d = *p[j] - *p[i];
+    const Real u = std::clamp((x - *p[i]).dot(d) / d.squaredNorm(), Real(0), Real(1));
+    const Real dist = (*p[i] + u * d - x).squaredNorm();
+    if (dist < best) {
+      best = dist;
+      out.setZero();
+      out[i] = 1 - u;
+      out[j] = u;
+    }
+  }
+  return out;
+}
+
+/// Barycentric coordinates of the point of tetrahedron (a, b, c, d) closest to x: x's own if
+/// it is inside, else the best over the faces opposite the negative coordinates (only those
+/// faces can hold the closest point).
+inline Vec<4> closest_barycentric(const Vec<3>& a, const Vec<3>& b, const Vec<3>& c, const Vec<3>& d, const Vec<3>& x) {
+  const Vec<4> l = barycentric(a, b, c, d, x);
+  if (l.minCoeff() >= 0) return l;
+  const std::array<const Vec<3>*, 4> p{&a, &b, &c, &d};
+  Real best = std::numeric_limits<Real>::infinity();
+  Vec<4> out = Vec<4>::Zero();
+  for (int k = 0; k < 4; ++k) {
+    if (l[k] >= 0) continue;
+    const auto& f = SimplexTopology<3>::facets[k];  // the face opposite vertex k
+    const Vec<3> q = closest_barycentric(*p[f[0]], *p[f[1]], *p[f[2]], x);
+    const Real dist = (q[0] * *p[f[0]] + q[1] * *p[f[1]] + q[2] * *p[f[2]] - x).squaredNorm();
+    if (dist < best) {
+      best = dist;
+      out.setZero();
+      for (int i = 0; i < 3; ++i) out[f[i]] = q[i];
+    }
+  }
+  return out;
+}
+
+/// Barycentric coordinates of x in cell c of a mesh, and of the cell's point closest to x.
+template <int D>
+Vec<D + 1> cell_barycentric(const Mesh<D>& m, Index c, const Vec<D>& x) {
+  const auto& v = m.cell(c);
+  if constexpr (D == 2)
+    return barycentric(m.node(v[0]), m.node(v[1]), m.node(v[2]), x);
+  else
+    return barycentric(m.node(v[0]), m.node(v[1]), m.node(v[2]), m.node(v[3]), x);
+}
+template <int D>
+Vec<D + 1> cell_closest_barycentric(const Mesh<D>& m, Index c, const Vec<D>& x) {
+  const auto& v = m.cell(c);
+  if constexpr (D == 2)
+    return closest_barycentric(m.node(v[0]), m.node(v[1]), m.node(v[2]), x);
+  else
+    return closest_barycentric(m.node(v[0]), m.node(v[1]), m.node(v[2]), m.node(v[3]), x);
+}
+
 }  // namespace detail
 
-class PointLocator2D {
+template <int D>
+class PointLocator {
+  static_assert(D == 2 || D == 3, "PointLocator: triangles or tetrahedra");
+  using Bary = Vec<D + 1>;
+  using Cell = std::array<int, D>;  // a bucket's grid coordinates
+
  public:
   /// Builds the bucket grid (O(n_cells)). The mesh must outlive the locator.
-  explicit PointLocator2D(const Mesh<2>& mesh, int max_walk = 64) : mesh_(&mesh), max_walk_(max_walk) {
+  explicit PointLocator(const Mesh<D>& mesh, int max_walk = 64) : mesh_(&mesh), max_walk_(max_walk) {
     ALEFSI_CHECK_ARG(max_walk >= 0, "max_walk", "must be >= 0, got ", max_walk);
     lo_ = hi_ = mesh.node(0);
     for (const auto& x : mesh.coordinates()) lo_ = lo_.cwiseMin(x), hi_ = hi_.cwiseMax(x);
-    const Vec<2> ext = (hi_ - lo_).cwiseMax(1e-300);
-    // about one bucket per cell, square-ish buckets
+    const Vec<D> ext = (hi_ - lo_).cwiseMax(1e-300);
+    // about one bucket per cell, cube-ish buckets
     const Real n = std::max<Real>(1, mesh.n_cells());
-    const Real side = std::sqrt(ext[0] * ext[1] / n);
-    nx_ = std::clamp(static_cast<int>(std::ceil(ext[0] / std::max(side, 1e-300))), 1, 1 << 14);
-    ny_ = std::clamp(static_cast<int>(std::ceil(ext[1] / std::max(side, 1e-300))), 1, 1 << 14);
-    inv_ = Vec<2>(nx_ / ext[0], ny_ / ext[1]);
-    const std::size_t nb = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_);
+    const Real side = std::pow(ext.prod() / n, Real(1) / D);
+    for (int d = 0; d < D; ++d) {
+      n_[d] = std::clamp(static_cast<int>(std::ceil(ext[d] / std::max(side, 1e-300))), 1, D == 2 ? 1 << 14 : 1 << 10);
+      inv_[d] = n_[d] / ext[d];
+    }
+    std::size_t nb = 1;
+    for (int d = 0; d < D; ++d) nb *= static_cast<std::size_t>(n_[d]);
     start_.assign(nb + 1, 0);
-    auto range = [&](Index c, int& i0, int& i1, int& j0, int& j1) {
-      Vec<2> a = mesh.node(mesh.cell(c)[0]), b = a;
+    auto range = [&](Index c, Cell& i0, Cell& i1) {
+      Vec<D> a = mesh.node(mesh.cell(c)[0]), b = a;
       for (Index v : mesh.cell(c)) a = a.cwiseMin(mesh.node(v)), b = b.cwiseMax(mesh.node(v));
-      i0 = bx(a[0]), i1 = bx(b[0]), j0 = by(a[1]), j1 = by(b[1]);
+      for (int d = 0; d < D; ++d) i0[d] = coord(a[d], d), i1[d] = coord(b[d], d);
     };
     for (Index c = 0; c < mesh.n_cells(); ++c) {
-      int i0, i1, j0, j1;
-      range(c, i0, i1, j0, j1);
-      for (int j = j0; j <= j1; ++j)
-        for (int i = i0; i <= i1; ++i) ++start_[bucket(i, j) + 1];
+      Cell i0, i1;
+      range(c, i0, i1);
+      for_box(i0, i1, [&](const Cell& i) { ++start_[bucket(i) + 1]; });
     }
     for (std::size_t b = 0; b < nb; ++b) start_[b + 1] += start_[b];
     items_.resize(start_[nb]);
     std::vector<Index> fill(start_.begin(), start_.end() - 1);
     for (Index c = 0; c < mesh.n_cells(); ++c) {
-      int i0, i1, j0, j1;
-      range(c, i0, i1, j0, j1);
-      for (int j = j0; j <= j1; ++j)
-        for (int i = i0; i <= i1; ++i) items_[fill[bucket(i, j)]++] = c;
+      Cell i0, i1;
+      range(c, i0, i1);
+      for_box(i0, i1, [&](const Cell& i) { items_[fill[bucket(i)]++] = c; });
     }
   }
 
   /// Cell containing x (or the nearest cell, see the file comment); the clamped
   /// barycentric coordinates go to *lambda if given. `hint`: a cell near x (or -1).
-  Index locate(const Vec<2>& x, Vec<3>* lambda = nullptr, Index hint = -1) const {
-    const Location l = find(x, hint);
+  Index locate(const Vec<D>& x, Bary* lambda = nullptr, Index hint = -1) const {
+    const PointLocation<D> l = find(x, hint);
     if (lambda) *lambda = l.lambda;
     return l.cell;
   }
 
   /// Full answer: cell, clamped and raw barycentrics, distance to the mesh.
-  Location find(const Vec<2>& x, Index hint = -1) const {
-    ALEFSI_CHECK_ARG(std::isfinite(x[0]) && std::isfinite(x[1]), "x", "must be finite");
+  PointLocation<D> find(const Vec<D>& x, Index hint = -1) const {
+    ALEFSI_CHECK_ARG(x.allFinite(), "x", "must be finite");
     ALEFSI_CHECK_ARG(hint < mesh_->n_cells(), "hint", "cell ", hint, " out of range");
     constexpr Real tol = -1e-12;
-    Location out;
     if (hint >= 0) {
       Index c = hint;
       for (int step = 0; step <= max_walk_; ++step) {
-        const Vec<3> l = bary(c, x);
+        const Bary l = detail::cell_barycentric(*mesh_, c, x);
         Index k;
         if (l.minCoeff(&k) >= tol) return inside(c, l);
         const auto& fc = mesh_->facet_cells(mesh_->cell_facets(c)[k]);  // facet opposite vertex k
@@ -146,14 +231,16 @@ class PointLocator2D {
       }
     }
     // bucket scan: the cell whose smallest barycentric coordinate is largest
-    if (x[0] >= lo_[0] && x[0] <= hi_[0] && x[1] >= lo_[1] && x[1] <= hi_[1]) {
-      const std::size_t b = bucket(bx(x[0]), by(x[1]));
+    if ((x.array() >= lo_.array()).all() && (x.array() <= hi_.array()).all()) {
+      Cell i;
+      for (int d = 0; d < D; ++d) i[d] = coord(x[d], d);
+      const std::size_t b = bucket(i);
       Real best = -std::numeric_limits<Real>::infinity();
       Index bc = -1;
-      Vec<3> bl;
+      Bary bl;
       for (Index p = start_[b]; p < start_[b + 1]; ++p) {
         const Index c = items_[p];
-        const Vec<3> l = bary(c, x);
+        const Bary l = detail::cell_barycentric(*mesh_, c, x);
         if (l.minCoeff() > best) best = l.minCoeff(), bc = c, bl = l;
       }
       if (bc >= 0 && best >= tol) return inside(bc, bl);
@@ -161,20 +248,30 @@ class PointLocator2D {
     return nearest(x);
   }
 
-  const Mesh<2>& mesh() const { return *mesh_; }
+  const Mesh<D>& mesh() const { return *mesh_; }
 
  private:
-  int bx(Real x) const { return std::clamp(static_cast<int>((x - lo_[0]) * inv_[0]), 0, nx_ - 1); }
-  int by(Real y) const { return std::clamp(static_cast<int>((y - lo_[1]) * inv_[1]), 0, ny_ - 1); }
-  std::size_t bucket(int i, int j) const { return static_cast<std::size_t>(j) * nx_ + i; }
-
-  Vec<3> bary(Index c, const Vec<2>& x) const {
-    const auto& v = mesh_->cell(c);
-    return detail::barycentric(mesh_->node(v[0]), mesh_->node(v[1]), mesh_->node(v[2]), x);
+  int coord(Real x, int d) const { return std::clamp(static_cast<int>((x - lo_[d]) * inv_[d]), 0, n_[d] - 1); }
+  std::size_t bucket(const Cell& i) const {
+    std::size_t b = 0;
+    for (int d = D - 1; d >= 0; --d) b = b * static_cast<std::size_t>(n_[d]) + static_cast<std::size_t>(i[d]);
+    return b;
+  }
+  // f(i) for every grid coordinate i in the box [i0, i1] (inclusive), first coordinate fastest
+  template <class F>
+  static void for_box(const Cell& i0, const Cell& i1, F&& f) {
+    Cell i = i0;
+    while (true) {
+      f(i);
+      int d = 0;
+      while (d < D && i[d] == i1[d]) i[d] = i0[d], ++d;
+      if (d == D) return;
+      ++i[d];
+    }
   }
 
-  static Location inside(Index c, const Vec<3>& l) {
-    Location out;
+  static PointLocation<D> inside(Index c, const Bary& l) {
+    PointLocation<D> out;
     out.cell = c;
     out.raw = l;
     // tiny negative round-off: clamp and renormalise (changes values by ~1e-12 relative)
@@ -184,53 +281,66 @@ class PointLocator2D {
     return out;
   }
 
-  /// Nearest cell by rings of buckets around x; stops once the ring is farther than the
-  /// best distance found.
-  Location nearest(const Vec<2>& x) const {
-    const Vec<2> cell_size((hi_[0] - lo_[0]) / nx_, (hi_[1] - lo_[1]) / ny_);
-    const Real step = std::min(cell_size[0], cell_size[1]);
-    // distance from x to the grid box, in rings
-    const int ci = static_cast<int>(std::floor((x[0] - lo_[0]) * inv_[0]));
-    const int cj = static_cast<int>(std::floor((x[1] - lo_[1]) * inv_[1]));
+  /// Nearest cell by shells of buckets around x (Chebyshev rings); stops once the ring is
+  /// farther than the best distance found.
+  PointLocation<D> nearest(const Vec<D>& x) const {
+    Real step = std::numeric_limits<Real>::infinity();
+    Cell ci;
+    int max_ring = 0, far = 0;
+    for (int d = 0; d < D; ++d) {
+      step = std::min(step, (hi_[d] - lo_[d]) / n_[d]);
+      ci[d] = static_cast<int>(std::floor((x[d] - lo_[d]) * inv_[d]));
+      max_ring = std::max(max_ring, n_[d]);
+      far = std::max({far, std::abs(ci[d]), std::abs(ci[d] - n_[d])});
+    }
+    max_ring += far;
     Real best = std::numeric_limits<Real>::infinity();
-    Location out;
-    const int max_ring = std::max(nx_, ny_) + std::max({std::abs(ci), std::abs(cj), std::abs(ci - nx_), std::abs(cj - ny_)});
+    PointLocation<D> out;
+    auto visit = [&](const Cell& i) {
+      const std::size_t b = bucket(i);
+      for (Index p = start_[b]; p < start_[b + 1]; ++p) {
+        const Index c = items_[p];
+        const Bary l = detail::cell_closest_barycentric(*mesh_, c, x);
+        const auto& v = mesh_->cell(c);
+        Vec<D> q = Vec<D>::Zero();
+        for (int k = 0; k <= D; ++k) q += l[k] * mesh_->node(v[k]);
+        const Real dist = (q - x).norm();
+        if (dist < best || (dist == best && c < out.cell)) {
+          best = dist;
+          out.cell = c;
+          out.lambda = l;
+          out.raw = detail::cell_barycentric(*mesh_, c, x);
+          out.distance = dist;
+        }
+      }
+    };
     for (int r = 0; r <= max_ring; ++r) {
       // every point in ring r is at least (r - 1) * step away from x
       if (out.cell >= 0 && (r - 1) * step > best) break;
-      for (int j = cj - r; j <= cj + r; ++j) {
-        if (j < 0 || j >= ny_) continue;
-        const bool edge_row = j == cj - r || j == cj + r;
-        for (int i = ci - r; i <= ci + r; i += (edge_row ? 1 : 2 * r)) {
-          if (i >= 0 && i < nx_) {
-            const std::size_t b = bucket(i, j);
-            for (Index p = start_[b]; p < start_[b + 1]; ++p) {
-              const Index c = items_[p];
-              const auto& v = mesh_->cell(c);
-              const Vec<2>&a = mesh_->node(v[0]), &bb = mesh_->node(v[1]), &cc = mesh_->node(v[2]);
-              const Vec<3> l = detail::closest_barycentric(a, bb, cc, x);
-              const Real d = (l[0] * a + l[1] * bb + l[2] * cc - x).norm();
-              if (d < best || (d == best && c < out.cell)) {
-                best = d;
-                out.cell = c;
-                out.lambda = l;
-                out.raw = detail::barycentric(a, bb, cc, x);
-                out.distance = d;
-              }
-            }
-          }
-          if (r == 0) break;
-        }
+      Cell i0, i1, j0, j1;  // the ring's box, and that box clipped to the grid
+      bool empty = false;
+      for (int d = 0; d < D; ++d) {
+        i0[d] = ci[d] - r, i1[d] = ci[d] + r;
+        j0[d] = std::max(i0[d], 0), j1[d] = std::min(i1[d], n_[d] - 1);
+        empty = empty || j0[d] > j1[d];
       }
+      if (empty) continue;
+      // the shell of the box: the cells with at least one coordinate on its faces
+      for_box(j0, j1, [&](const Cell& i) {
+        for (int d = 0; d < D; ++d)
+          if (i[d] == i0[d] || i[d] == i1[d]) return visit(i);
+      });
     }
     return out;
   }
 
-  const Mesh<2>* mesh_;
+  const Mesh<D>* mesh_;
   int max_walk_;
-  Vec<2> lo_, hi_, inv_;
-  int nx_ = 1, ny_ = 1;
+  Vec<D> lo_, hi_, inv_;
+  Cell n_;
   std::vector<Index> start_, items_;
 };
+
+using PointLocator2D = PointLocator<2>;
 
 }  // namespace alefsi

@@ -1,13 +1,13 @@
 #pragma once
 /// \file mesh/adapt/transfer.hpp
-/// Transfer of P1 / P2 finite-element fields from one 2D mesh to another (after mesh
-/// adaptation) by interpolation at the new DOF points.
+/// Transfer of P1 / P2 finite-element fields from one triangle (2D) or tetrahedron (3D) mesh to
+/// another (after mesh adaptation) by interpolation at the new DOF points.
 ///
 /// Algorithm: every DOF point of the target space (P1: the nodes; P2: the nodes, then one
 /// point per edge, by default the straight midpoint) is located in the source mesh
-/// (`PointLocator2D`: walk from the cell found for a neighbouring point, bucket grid as
+/// (`PointLocator<D>`: walk from the cell found for a neighbouring point, bucket grid as
 /// fall-back); the source field is evaluated there with the P1 / P2 shape functions of
-/// the containing cell. The located cells and weights are stored once (`FieldTransfer2D`)
+/// the containing cell. The located cells and weights are stored once (`FieldTransfer<D>`)
 /// and applied to any number of fields / history levels / components.
 ///
 /// Exactness: a field in the source FE space is reproduced exactly (to round-off) at
@@ -15,8 +15,8 @@
 /// affine fields and P2 transfer for quadratic fields, and the error for a smooth field
 /// is the interpolation error, O(h^2) for P1 and O(h^3) for P2 (max norm).
 ///
-/// Points outside the source mesh (a new boundary node put on a circle arc lies outside
-/// the inscribed polygon of the old mesh, at a distance O(h^2 / radius)): by default
+/// Points outside the source mesh (a new boundary node put on a circle arc / a sphere lies
+/// outside the inscribed polygon / polyhedron of the old mesh, at a distance O(h^2 / radius)): by default
 /// (`OutsidePolicy::clamp`) the value at the point of the nearest source cell closest to
 /// it (clamped barycentric coordinates: bounded, no overshoot, error O(|grad f| * distance)
 /// = O(h^2)); with `OutsidePolicy::extrapolate` the nearest cell's polynomial evaluated
@@ -30,7 +30,7 @@
 /// Cost: construction O(n_source + n_target) (walks of O(1) steps when the meshes are
 /// close, as after an adaptation); each application O(n_target * k).
 ///
-///     alefsi::FieldTransfer2D T(old_mesh, new_mesh, 2);          // P2 plan
+///     alefsi::FieldTransfer2D T(old_mesh, new_mesh, 2);          // P2 plan (FieldTransfer<3>: tets)
 ///     std::vector<Real> u_new = T.apply(u_old, 2);               // 2 components per DOF
 ///     auto p_new = alefsi::transfer<1>(old_mesh, p_old, 1, new_mesh);
 #include <algorithm>
@@ -50,25 +50,36 @@ enum class OutsidePolicy { clamp, extrapolate };
 
 namespace detail {
 
-/// P1 / P2 shape function values at barycentric coordinates l (local order of lagrange.hpp).
-inline std::array<Real, 6> lagrange_weights(int degree, const Vec<3>& l) {
-  if (degree == 1) return {l[0], l[1], l[2], 0, 0, 0};
-  return {l[0] * (2 * l[0] - 1), l[1] * (2 * l[1] - 1), l[2] * (2 * l[2] - 1),
-          4 * l[0] * l[1],       4 * l[1] * l[2],       4 * l[2] * l[0]};
+/// P1 / P2 shape function values at barycentric coordinates l (local order of lagrange.hpp:
+/// vertices, then the edges of SimplexTopology<D>).
+template <int D>
+std::array<Real, 10> lagrange_weights(int degree, const Vec<D + 1>& l) {
+  std::array<Real, 10> w{};
+  for (int i = 0; i <= D; ++i) w[i] = degree == 1 ? l[i] : l[i] * (2 * l[i] - 1);
+  if (degree == 2)
+    for (std::size_t e = 0; e < SimplexTopology<D>::edges.size(); ++e) {
+      const auto [a, b] = SimplexTopology<D>::edges[e];
+      w[D + 1 + e] = 4 * l[a] * l[b];
+    }
+  return w;
 }
 
 /// Number of DOFs of the scalar P1 / P2 space on a mesh (numbering of DofMap).
-inline Index lagrange_dofs(const Mesh<2>& m, int degree) { return m.n_nodes() + (degree == 2 ? m.n_edges() : 0); }
+template <int D>
+Index lagrange_dofs(const Mesh<D>& m, int degree) { return m.n_nodes() + (degree == 2 ? m.n_edges() : 0); }
 
 }  // namespace detail
 
 /// Precomputed interpolation from the P`degree` space of `from` to that of `to`.
-class FieldTransfer2D {
+template <int D>
+class FieldTransfer {
+  static constexpr int ne = static_cast<int>(SimplexTopology<D>::edges.size());
+
  public:
   /// `to_edge_points` (P2 only, optional): the DOF point of each edge of `to` (indexed as
   /// to.edges()), e.g. the arc midpoint for edges on a circle; default: straight midpoints.
-  FieldTransfer2D(const Mesh<2>& from, const Mesh<2>& to, int degree, const std::vector<Vec<2>>& to_edge_points = {},
-                  OutsidePolicy outside = OutsidePolicy::clamp)
+  FieldTransfer(const Mesh<D>& from, const Mesh<D>& to, int degree, const std::vector<Vec<D>>& to_edge_points = {},
+                OutsidePolicy outside = OutsidePolicy::clamp)
       : degree_(degree) {
     ALEFSI_CHECK_ARG(degree == 1 || degree == 2, "degree", "must be 1 or 2, got ", degree);
     ALEFSI_CHECK_ARG(to_edge_points.empty() || (degree == 2 && to_edge_points.size() == std::size_t(to.n_edges())),
@@ -76,10 +87,10 @@ class FieldTransfer2D {
                      to_edge_points.size());
     n_from_ = detail::lagrange_dofs(from, degree);
     n_to_ = detail::lagrange_dofs(to, degree);
-    nl_ = degree == 1 ? 3 : 6;
+    nl_ = degree == 1 ? D + 1 : D + 1 + ne;
     idx_.resize(std::size_t(n_to_) * nl_);
     w_.resize(std::size_t(n_to_) * nl_);
-    const PointLocator2D loc(from);
+    const PointLocator<D> loc(from);
 
     // a neighbour with a smaller index for each target node: its cell is the walk's start
     std::vector<Index> nb(std::size_t(to.n_nodes()), -1);
@@ -87,14 +98,14 @@ class FieldTransfer2D {
       if (nb[e[1]] < 0 || e[0] < nb[e[1]]) nb[e[1]] = e[0];
     std::vector<Index> found(std::size_t(to.n_nodes()), -1);
     Index prev = -1;
-    auto store = [&](Index dof, const Vec<2>& x, Index hint) {
-      const Location l = loc.find(x, hint);
+    auto store = [&](Index dof, const Vec<D>& x, Index hint) {
+      const PointLocation<D> l = loc.find(x, hint);
       if (l.distance > 0) ++n_outside_, max_outside_ = std::max(max_outside_, l.distance);
-      const auto w = detail::lagrange_weights(degree, outside == OutsidePolicy::extrapolate ? l.raw : l.lambda);
+      const auto w = detail::lagrange_weights<D>(degree, outside == OutsidePolicy::extrapolate ? l.raw : l.lambda);
       const auto& cv = from.cell(l.cell);
-      for (int i = 0; i < 3; ++i) idx_[std::size_t(dof) * nl_ + i] = cv[i];
+      for (int i = 0; i <= D; ++i) idx_[std::size_t(dof) * nl_ + i] = cv[i];
       if (degree == 2)
-        for (int e = 0; e < 3; ++e) idx_[std::size_t(dof) * nl_ + 3 + e] = from.n_nodes() + from.cell_edges(l.cell)[e];
+        for (int e = 0; e < ne; ++e) idx_[std::size_t(dof) * nl_ + D + 1 + e] = from.n_nodes() + from.cell_edges(l.cell)[e];
       for (int i = 0; i < nl_; ++i) w_[std::size_t(dof) * nl_ + i] = w[i];
       return l.cell;
     };
@@ -105,7 +116,7 @@ class FieldTransfer2D {
     if (degree == 2)
       for (Index e = 0; e < to.n_edges(); ++e) {
         const auto& ev = to.edge(e);
-        const Vec<2> x = to_edge_points.empty() ? Vec<2>(0.5 * (to.node(ev[0]) + to.node(ev[1]))) : to_edge_points[e];
+        const Vec<D> x = to_edge_points.empty() ? Vec<D>(0.5 * (to.node(ev[0]) + to.node(ev[1]))) : to_edge_points[e];
         store(to.n_nodes() + e, x, found[ev[0]]);
       }
   }
@@ -153,20 +164,22 @@ class FieldTransfer2D {
 
  private:
   int degree_;
-  int nl_ = 3;
+  int nl_ = D + 1;
   Index n_from_ = 0, n_to_ = 0, n_outside_ = 0;
   Real max_outside_ = 0;
   std::vector<Index> idx_;
   std::vector<Real> w_;
 };
 
+using FieldTransfer2D = FieldTransfer<2>;
+
 /// One-shot transfer of a P`K` field (K = 1 or 2) with `components` interleaved
-/// components per DOF; see FieldTransfer2D.
-template <int K>
-std::vector<Real> transfer(const Mesh<2>& from, const std::vector<Real>& values, int components, const Mesh<2>& to,
-                           const std::vector<Vec<2>>& to_edge_points = {}, OutsidePolicy outside = OutsidePolicy::clamp) {
+/// components per DOF; see FieldTransfer<D>.
+template <int K, int D>
+std::vector<Real> transfer(const Mesh<D>& from, const std::vector<Real>& values, int components, const Mesh<D>& to,
+                           const std::vector<Vec<D>>& to_edge_points = {}, OutsidePolicy outside = OutsidePolicy::clamp) {
   static_assert(K == 1 || K == 2, "transfer<K>: K is the Lagrange degree, 1 or 2");
-  return FieldTransfer2D(from, to, K, to_edge_points, outside).apply(values, components);
+  return FieldTransfer<D>(from, to, K, to_edge_points, outside).apply(values, components);
 }
 
 }  // namespace alefsi

@@ -7,6 +7,7 @@
 #include <functional>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "alefsi/mesh/adapt.hpp"
@@ -80,6 +81,43 @@ std::vector<double> interpolate(const Mesh<2>& m, int degree, const std::functio
 }
 std::vector<double> interpolate(const Mesh<3>& m, int degree, const std::function<double(const Vec<3>&)>& f) {
   return interpolate<3>(m, degree, f);
+}
+
+/// P1 transfer of an affine field (gradient norm `grad`) to a mesh with nodes outside `from`:
+/// extrapolated, exact for the space; clamped, no overshoot and an error within grad times the
+/// distance to the old mesh. Returns that largest distance.
+template <int D>
+double check_outside_points(const Mesh<D>& from, const Mesh<D>& to, const std::function<double(const Vec<D>&)>& lin,
+                            double grad) {
+  const FieldTransfer<D> clamp(from, to, 1), extra(from, to, 1, {}, OutsidePolicy::extrapolate);
+  std::printf("%dD outside points: %d of %d, max distance %.2e\n", D, clamp.n_outside(), to.n_nodes(),
+              clamp.max_outside_distance());
+  CHECK(clamp.n_outside() > 0);
+  CHECK(clamp.n_outside() == extra.n_outside());
+  const auto src = interpolate<D>(from, 1, lin);
+  const double lo = *std::min_element(src.begin(), src.end()), hi = *std::max_element(src.begin(), src.end());
+  const auto vc = clamp.apply(src), ve = extra.apply(src);
+  double err_c = 0;
+  for (Index i = 0; i < to.n_nodes(); ++i) {
+    const double exact = lin(to.node(i));
+    err_c = std::max(err_c, std::abs(vc[i] - exact));
+    CHECK(std::abs(ve[i] - exact) <= 1e-12);              // extrapolation: exact for the space
+    CHECK((vc[i] >= lo - 1e-12 && vc[i] <= hi + 1e-12));  // clamping: no overshoot
+  }
+  CHECK(err_c > 1e-8);  // the clamped value is the one at the nearest point of the old mesh
+  CHECK(err_c <= grad * clamp.max_outside_distance() + 1e-12);
+  return clamp.max_outside_distance();
+}
+
+/// Max and rms error of the P`degree` transfer of f from `from` to `to`, at the DOF points of `to`.
+template <int D>
+std::pair<double, double> transfer_error(const Mesh<D>& from, const Mesh<D>& to, int degree,
+                                         const std::function<double(const Vec<D>&)>& f) {
+  const auto v = FieldTransfer<D>(from, to, degree).apply(interpolate<D>(from, degree, f));
+  const auto e = interpolate<D>(to, degree, f);
+  double mx = 0, s2 = 0;
+  for (std::size_t i = 0; i < v.size(); ++i) mx = std::max(mx, std::abs(v[i] - e[i])), s2 += (v[i] - e[i]) * (v[i] - e[i]);
+  return {mx, std::sqrt(s2 / double(v.size()))};
 }
 
 /// box_mesh of the unit cube moved by a smooth map onto itself (boundary fixed).
@@ -418,25 +456,8 @@ TEST_CASE("transfer: outside points (curved boundary) clamped or extrapolated", 
   const Mesh<2> from = annulus_unstructured(0.25, 1.0, 0.12);
   const Mesh<2> to = annulus_unstructured(0.25, 1.0, 0.05);
   auto lin = [](const Vec<2>& x) { return 2.0 + 3.0 * x[0] - 1.0 * x[1]; };
-  const double grad = std::sqrt(10.0);
-  const FieldTransfer2D clamp(from, to, 1);
-  const FieldTransfer2D extra(from, to, 1, {}, OutsidePolicy::extrapolate);
-  std::printf("outside points: %d of %d, max distance %.2e\n", clamp.n_outside(), to.n_nodes(), clamp.max_outside_distance());
-  CHECK(clamp.n_outside() > 0);
-  CHECK(clamp.n_outside() == extra.n_outside());
-  CHECK(clamp.max_outside_distance() <= 0.12 * 0.12 / (8 * 0.25) * 1.5);
-  const auto src = interpolate(from, 1, lin);
-  const double lo = *std::min_element(src.begin(), src.end()), hi = *std::max_element(src.begin(), src.end());
-  const auto vc = clamp.apply(src), ve = extra.apply(src);
-  double err_c = 0;
-  for (Index i = 0; i < to.n_nodes(); ++i) {
-    const double exact = lin(to.node(i));
-    err_c = std::max(err_c, std::abs(vc[i] - exact));
-    CHECK(std::abs(ve[i] - exact) <= 1e-12);          // extrapolation: exact for the space
-    CHECK((vc[i] >= lo - 1e-12 && vc[i] <= hi + 1e-12));  // clamping: no overshoot
-  }
-  CHECK(err_c > 1e-8);  // the clamped value is the one at the nearest point of the old mesh
-  CHECK(err_c <= grad * clamp.max_outside_distance() + 1e-12);
+  const double outside = check_outside_points<2>(from, to, lin, std::sqrt(10.0));
+  CHECK(outside <= 0.12 * 0.12 / (8 * 0.25) * 1.5);
 
   // P2 with the edge DOFs of the boundary edges on the arcs: quadratic field reproduced
   // by extrapolation; clamped: error O(h^2) at those points only
@@ -452,7 +473,7 @@ TEST_CASE("transfer: outside points (curved boundary) clamped or extrapolated", 
     CHECK(std::abs(v2[i] - quad(p)) <= 1e-12);
     err2 = std::max(err2, std::abs(c2[i] - quad(p)));
   }
-  CHECK(err2 <= 4 * clamp.max_outside_distance());
+  CHECK(err2 <= 4 * outside);
 }
 
 TEST_CASE("transfer: convergence at the interpolation order for a smooth field", "[mesh][adapt]") {
@@ -461,12 +482,8 @@ TEST_CASE("transfer: convergence at the interpolation order for a smooth field",
   for (int degree : {1, 2}) {
     std::vector<double> emax, erms;
     for (int n : {8, 16, 32, 64}) {
-      const Mesh<2> from = perturbed_square(n);
-      const auto v = FieldTransfer2D(from, to, degree).apply(interpolate(from, degree, f));
-      const auto e = interpolate(to, degree, f);
-      double mx = 0, s2 = 0;
-      for (std::size_t i = 0; i < v.size(); ++i) mx = std::max(mx, std::abs(v[i] - e[i])), s2 += (v[i] - e[i]) * (v[i] - e[i]);
-      emax.push_back(mx), erms.push_back(std::sqrt(s2 / double(v.size())));
+      const auto [mx, rms] = transfer_error<2>(perturbed_square(n), to, degree, f);
+      emax.push_back(mx), erms.push_back(rms);
     }
     for (std::size_t k = 1; k < emax.size(); ++k) {
       const double rmax = std::log2(emax[k - 1] / emax[k]), rrms = std::log2(erms[k - 1] / erms[k]);
@@ -558,23 +575,7 @@ TEST_CASE("transfer in 3D: a spherical shell's new boundary points, clamped or e
   // the finer shell's boundary nodes lie on the spheres, outside the coarse one's polyhedra
   const Mesh<3> from = spherical_shell_mesh(0.5, 1.0, 1), to = spherical_shell_mesh(0.5, 1.0, 2);
   auto lin = [](const Vec<3>& x) { return 2.0 + 3.0 * x[0] - 1.0 * x[1] + 0.5 * x[2]; };
-  const double grad = std::sqrt(9.0 + 1.0 + 0.25);
-  const FieldTransfer<3> clamp(from, to, 1), extra(from, to, 1, {}, OutsidePolicy::extrapolate);
-  std::printf("3D outside points: %d of %d, max distance %.2e\n", clamp.n_outside(), to.n_nodes(), clamp.max_outside_distance());
-  CHECK(clamp.n_outside() > 0);
-  CHECK(clamp.n_outside() == extra.n_outside());
-  const auto src = interpolate(from, 1, lin);
-  const double lo = *std::min_element(src.begin(), src.end()), hi = *std::max_element(src.begin(), src.end());
-  const auto vc = clamp.apply(src), ve = extra.apply(src);
-  double err_c = 0;
-  for (Index i = 0; i < to.n_nodes(); ++i) {
-    const double exact = lin(to.node(i));
-    err_c = std::max(err_c, std::abs(vc[i] - exact));
-    CHECK(std::abs(ve[i] - exact) <= 1e-12);              // extrapolation: exact for the space
-    CHECK((vc[i] >= lo - 1e-12 && vc[i] <= hi + 1e-12));  // clamping: no overshoot
-  }
-  CHECK(err_c > 1e-8);
-  CHECK(err_c <= grad * clamp.max_outside_distance() + 1e-12);
+  check_outside_points<3>(from, to, lin, std::sqrt(9.0 + 1.0 + 0.25));
 }
 
 TEST_CASE("transfer in 3D: convergence at the interpolation order for a smooth field", "[mesh][adapt]") {
@@ -583,12 +584,8 @@ TEST_CASE("transfer in 3D: convergence at the interpolation order for a smooth f
   for (int degree : {1, 2}) {
     std::vector<double> emax, erms;
     for (int n : {4, 8, 16}) {
-      const Mesh<3> from = perturbed_cube(n);
-      const auto v = FieldTransfer<3>(from, to, degree).apply(interpolate(from, degree, f));
-      const auto e = interpolate(to, degree, f);
-      double mx = 0, s2 = 0;
-      for (std::size_t i = 0; i < v.size(); ++i) mx = std::max(mx, std::abs(v[i] - e[i])), s2 += (v[i] - e[i]) * (v[i] - e[i]);
-      emax.push_back(mx), erms.push_back(std::sqrt(s2 / double(v.size())));
+      const auto [mx, rms] = transfer_error<3>(perturbed_cube(n), to, degree, f);
+      emax.push_back(mx), erms.push_back(rms);
     }
     for (std::size_t k = 1; k < emax.size(); ++k) {
       const double rmax = std::log2(emax[k - 1] / emax[k]), rrms = std::log2(erms[k - 1] / erms[k]);

@@ -53,6 +53,7 @@
 #include <vector>
 
 #include "alefsi/core/error.hpp"
+#include "alefsi/core/grid.hpp"
 #include "alefsi/core/types.hpp"
 
 namespace alefsi {
@@ -300,18 +301,6 @@ CellKey<D> key_of(const Vec<D>& x, Real cell) {
   for (int d = 0; d < D; ++d) k[d] = std::int64_t(std::floor(x[d] / cell));
   return k;
 }
-/// Calls f(key) for every grid cell of the box [a, b] (cell keys, inclusive).
-template <int D, class F>
-void for_cells(const CellKey<D>& a, const CellKey<D>& b, F&& f) {
-  CellKey<D> k = a;
-  while (true) {
-    f(k);
-    int d = 0;
-    while (d < D && k[d] == b[d]) k[d] = a[d], ++d;
-    if (d == D) return;
-    ++k[d];
-  }
-}
 
 }  // namespace detail
 
@@ -338,7 +327,7 @@ class ContactGeometry {
     for (std::size_t w = 0; w < walls_.size(); ++w) {
       Vec<D> lo = walls_[w][0], hi = walls_[w][0];
       for (const auto& x : walls_[w]) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
-      detail::for_cells<D>(detail::key_of<D>(lo, wall_cell_), detail::key_of<D>(hi, wall_cell_),
+      for_each_in_box(detail::key_of<D>(lo, wall_cell_), detail::key_of<D>(hi, wall_cell_),
                            [&](const detail::CellKey<D>& key) { grid_[key].push_back(Index(w)); });
     }
   }
@@ -364,7 +353,7 @@ class ContactGeometry {
       for (std::size_t k = 0; k < bodies.size(); ++k) {
         detail::CellKey<D> a = detail::key_of<D>(bodies[k].centre, cell), b = a;
         for (int d = 0; d < D; ++d) --a[d], ++b[d];
-        detail::for_cells<D>(a, b, [&](const detail::CellKey<D>& key) {
+        for_each_in_box(a, b, [&](const detail::CellKey<D>& key) {
           const auto it = cells.find(key);
           if (it == cells.end()) return;
           for (int j : it->second)
@@ -450,7 +439,7 @@ class ContactGeometry {
       const Vec<D> r = Vec<D>::Constant(b.r_out + delta);
       const Vec<D> qlo = (b.centre - r).cwiseMax(lo_), qhi = (b.centre + r).cwiseMin(hi_);  // only cells that hold walls
       if ((qlo.array() > qhi.array()).any()) return;
-      detail::for_cells<D>(detail::key_of<D>(qlo, wall_cell_), detail::key_of<D>(qhi, wall_cell_),
+      for_each_in_box(detail::key_of<D>(qlo, wall_cell_), detail::key_of<D>(qhi, wall_cell_),
                            [&](const detail::CellKey<D>& key) {
                              const auto it = grid_.find(key);
                              if (it != grid_.end()) cand.insert(cand.end(), it->second.begin(), it->second.end());

@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "alefsi/core/error.hpp"
+#include "alefsi/core/grid.hpp"
 #include "alefsi/core/types.hpp"
 #include "alefsi/mesh/mesh.hpp"
 
@@ -70,17 +71,16 @@ inline Vec<4> barycentric(const Vec<3>& a, const Vec<3>& b, const Vec<3>& c, con
   return Vec<4>(1 - l1 - l2 - l3, l1, l2, l3);
 }
 
-/// Barycentric coordinates of the point of triangle (a, b, c) closest to x.
-inline Vec<3> closest_barycentric(const Vec<2>& a, const Vec<2>& b, const Vec<2>& c, const Vec<2>& x) {
-  Vec<3> l = barycentric(a, b, c, x);
-  if (l.minCoeff() >= 0) return l;
-  // closest point lies on one of the edges: take the best of the three projections
-  const std::array<const Vec<2>*, 3> p{&a, &b, &c};
+/// Barycentric coordinates (in a, b, c) of the point of triangle (a, b, c)'s edges closest to x
+/// (2D or 3D): the best of the three clamped projections.
+template <int D>
+Vec<3> closest_on_edges(const Vec<D>& a, const Vec<D>& b, const Vec<D>& c, const Vec<D>& x) {
+  const std::array<const Vec<D>*, 3> p{&a, &b, &c};
   Real best = std::numeric_limits<Real>::infinity();
-  Vec<3> out = l;
+  Vec<3> out = Vec<3>::Zero();
   for (int i = 0; i < 3; ++i) {
     const int j = (i + 1) % 3;
-    const Vec<2> d = *p[j] - *p[i];
+    const Vec<D> d = *p[j] - *p[i];
     const Real t = std::clamp((x - *p[i]).dot(d) / d.squaredNorm(), Real(0), Real(1));
     const Real dist = (*p[i] + t * d - x).squaredNorm();
     if (dist < best) {
@@ -93,6 +93,13 @@ inline Vec<3> closest_barycentric(const Vec<2>& a, const Vec<2>& b, const Vec<2>
   return out;
 }
 
+/// Barycentric coordinates of the point of triangle (a, b, c) closest to x.
+inline Vec<3> closest_barycentric(const Vec<2>& a, const Vec<2>& b, const Vec<2>& c, const Vec<2>& x) {
+  const Vec<3> l = barycentric(a, b, c, x);
+  if (l.minCoeff() >= 0) return l;
+  return closest_on_edges<2>(a, b, c, x);  // the closest point lies on an edge
+}
+
 /// Barycentric coordinates (in a, b, c) of the point of the 3D triangle (a, b, c) closest to x:
 /// the projection onto its plane if that is inside, else the best of its three edges.
 inline Vec<3> closest_barycentric(const Vec<3>& a, const Vec<3>& b, const Vec<3>& c, const Vec<3>& x) {
@@ -101,22 +108,7 @@ inline Vec<3> closest_barycentric(const Vec<3>& a, const Vec<3>& b, const Vec<3>
   const Real det = g11 * g22 - g12 * g12;
   const Real s = (g22 * r1 - g12 * r2) / det, t = (g11 * r2 - g12 * r1) / det;
   if (s >= 0 && t >= 0 && s + t <= 1) return Vec<3>(1 - s - t, s, t);
-  const std::array<const Vec<3>*, 3> p{&a, &b, &c};
-  Real best = std::numeric_limits<Real>::infinity();
-  Vec<3> out = Vec<3>::Zero();
-  for (int i = 0; i < 3; ++i) {
-    const int j = (i + 1) % 3;
-    const Vec<3> d = *p[j] - *p[i];
-    const Real u = std::clamp((x - *p[i]).dot(d) / d.squaredNorm(), Real(0), Real(1));
-    const Real dist = (*p[i] + u * d - x).squaredNorm();
-    if (dist < best) {
-      best = dist;
-      out.setZero();
-      out[i] = 1 - u;
-      out[j] = u;
-    }
-  }
-  return out;
+  return closest_on_edges<3>(a, b, c, x);
 }
 
 /// Barycentric coordinates of the point of tetrahedron (a, b, c, d) closest to x: x's own if
@@ -193,7 +185,7 @@ class PointLocator {
     for (Index c = 0; c < mesh.n_cells(); ++c) {
       Cell i0, i1;
       range(c, i0, i1);
-      for_box(i0, i1, [&](const Cell& i) { ++start_[bucket(i) + 1]; });
+      for_each_in_box(i0, i1, [&](const Cell& i) { ++start_[bucket(i) + 1]; });
     }
     for (std::size_t b = 0; b < nb; ++b) start_[b + 1] += start_[b];
     items_.resize(start_[nb]);
@@ -201,7 +193,7 @@ class PointLocator {
     for (Index c = 0; c < mesh.n_cells(); ++c) {
       Cell i0, i1;
       range(c, i0, i1);
-      for_box(i0, i1, [&](const Cell& i) { items_[fill[bucket(i)]++] = c; });
+      for_each_in_box(i0, i1, [&](const Cell& i) { items_[fill[bucket(i)]++] = c; });
     }
   }
 
@@ -257,19 +249,6 @@ class PointLocator {
     for (int d = D - 1; d >= 0; --d) b = b * static_cast<std::size_t>(n_[d]) + static_cast<std::size_t>(i[d]);
     return b;
   }
-  // f(i) for every grid coordinate i in the box [i0, i1] (inclusive), first coordinate fastest
-  template <class F>
-  static void for_box(const Cell& i0, const Cell& i1, F&& f) {
-    Cell i = i0;
-    while (true) {
-      f(i);
-      int d = 0;
-      while (d < D && i[d] == i1[d]) i[d] = i0[d], ++d;
-      if (d == D) return;
-      ++i[d];
-    }
-  }
-
   static PointLocation<D> inside(Index c, const Bary& l) {
     PointLocation<D> out;
     out.cell = c;
@@ -326,7 +305,7 @@ class PointLocator {
       }
       if (empty) continue;
       // the shell of the box: the cells with at least one coordinate on its faces
-      for_box(j0, j1, [&](const Cell& i) {
+      for_each_in_box(j0, j1, [&](const Cell& i) {
         for (int d = 0; d < D; ++d)
           if (i[d] == i0[d] || i[d] == i1[d]) return visit(i);
       });

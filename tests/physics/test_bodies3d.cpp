@@ -519,3 +519,37 @@ TEST_CASE("scenes::SettlingSphere: bad parameters are refused by name; the wall 
   const Real stokes = 2.0 / 9.0 * (s.rho_s - s.rho_f) * 980 * s.a * s.a / s.mu;
   CHECK(s.terminal_speed() == Approx(stokes / s.wall_factor()).epsilon(1e-12));
 }
+
+TEST_CASE("3D scene refusals name the body: a sphere tag missing from a gmsh file, a sphere whose radius or centre "
+          "is not its surface's",
+          "[bodies3d][quick]") {
+  // sphere_in_box3d.msh: the walls are tag 1, the sphere (a = 0.2 at the origin) tag 5
+  using Flow = AleFlow<FlowConfig<3, P1P1Gls, BDF2_BDF2E>>;
+  auto refused = [](const RigidBody3D& second, const std::string& parameter, const std::string& what) {
+    Flow flow(gmsh_mesh("sphere_in_box3d.msh"), {.rho = 1, .mu = 1});
+    flow.add_body(sphere_body(5, Vec<3>::Zero(), 0.2, 1.5));  // the right one
+    try {
+      flow.add_body(second);
+      flow.step(0.01);
+      FAIL("accepted: " << what);
+    } catch (const InvalidArgument& e) {
+      CHECK(e.parameter() == parameter);
+      CHECK_THAT(e.what(), Catch::Contains(what));
+    }
+  };
+  refused(sphere_body(6, Vec<3>::Zero(), 0.2, 1.5), "body.tag", "bodies[1]: no boundary facet has its tag 6");
+  refused(sphere_body(5, Vec<3>::Zero(), 0.2, 1.5), "body.tag", "bodies[1] has the tag 5 of an earlier body");
+  auto wrong = [](const RigidBody3D& body, const std::string& what) {
+    Flow flow(gmsh_mesh("sphere_in_box3d.msh"), {.rho = 1, .mu = 1});
+    try {
+      flow.add_body(body);
+      flow.step(0.01);
+      FAIL("accepted: " << what);
+    } catch (const InvalidArgument& e) {
+      CHECK(e.parameter() == "body.radius");
+      CHECK_THAT(e.what(), Catch::Contains(what));
+    }
+  };
+  wrong(sphere_body(5, Vec<3>::Zero(), 0.25, 1.5), "bodies[0] (tag 5): surface node");
+  wrong(sphere_body(5, Vec<3>(0.01, 0, 0), 0.2, 1.5), "bodies[0] (tag 5): surface node");
+}

@@ -68,7 +68,7 @@ class BodySystem {
     const std::size_t k = entries_.size();
     M::validate(body, k);
     const int tag = M::tag(body);
-    ALEFSI_CHECK_ARG(!mesh.boundary_nodes(tag).empty(), "body.tag", "no boundary facet has tag ", tag);
+    ALEFSI_CHECK_ARG(!mesh.boundary_nodes(tag).empty(), "body.tag", "bodies[", k, "]: no boundary facet has its tag ", tag);
     for (const auto& e : entries_)
       ALEFSI_CHECK_ARG(M::tag(e.data) != tag, "body.tag", "bodies[", k, "] has the tag ", tag, " of an earlier body");
     Entry e;
@@ -169,7 +169,7 @@ class BodySystem {
       if (radius <= 0) continue;
       for (Index v : e.nodes)
         ALEFSI_CHECK_ARG(std::abs((mesh.node(v) - states[k].centre[0]).norm() - radius) <= 1e-6 * radius,
-                         "body.radius", "body with tag ", M::tag(e.data), ": surface node ", v, " is at distance ",
+                         "body.radius", "bodies[", k, "] (tag ", M::tag(e.data), "): surface node ", v, " is at distance ",
                          (mesh.node(v) - states[k].centre[0]).norm(), " from the centre, not the radius ", radius);
     }
   }

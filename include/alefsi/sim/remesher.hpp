@@ -19,12 +19,15 @@
 /// whose surface the remesher keeps exact).
 ///
 /// Remeshers: `Remesher2D` (sim/remesher2d.hpp: split / collapse / flip / smoothing with disks on
-/// their exact circles). A 3D remesher implements the same three functions (issue 15).
+/// their exact circles) and `Remesher3D` (sim/remesher3d.hpp: a new mesh of the box with its
+/// spheres from gmsh, when alefsi::gmsh is linked). Both transfer by `LagrangeTransfer<D>`.
 #include <memory>
 #include <optional>
 #include <vector>
 
+#include "alefsi/core/error.hpp"
 #include "alefsi/core/types.hpp"
+#include "alefsi/mesh/adapt/transfer.hpp"
 #include "alefsi/mesh/mesh.hpp"
 
 namespace alefsi {
@@ -51,6 +54,25 @@ class MeshTransfer {
   /// A field of the degree-`degree` Lagrange space with `components` interleaved components
   /// per DOF (DofMap numbering: nodes, then edges).
   virtual std::vector<Real> apply(const std::vector<Real>& values, int components, int degree) const = 0;
+};
+
+/// The MeshTransfer of both remeshers: interpolation (FieldTransfer<D>) by P1 and by the
+/// velocity degree, the plans built once per remesh.
+template <int D>
+class LagrangeTransfer final : public MeshTransfer<D> {
+ public:
+  LagrangeTransfer(const Mesh<D>& from, const Mesh<D>& to, int velocity_degree) : p1_(from, to, 1) {
+    if (velocity_degree != 1) pk_.emplace(from, to, velocity_degree);
+  }
+  std::vector<Real> apply(const std::vector<Real>& values, int components, int degree) const override {
+    if (degree == 1) return p1_.apply(values, components);
+    ALEFSI_ASSERT(pk_ && pk_->degree() == degree);
+    return pk_->apply(values, components);
+  }
+
+ private:
+  FieldTransfer<D> p1_;
+  std::optional<FieldTransfer<D>> pk_;
 };
 
 template <int D>

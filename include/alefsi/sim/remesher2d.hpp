@@ -2,7 +2,7 @@
 /// \file sim/remesher2d.hpp
 /// The 2D remesher behind the `Remesher<2>` seam (sim/remesher.hpp): mesh/adapt/adapt2d.hpp's
 /// split / collapse / flip / smoothing adaptation, disks kept on their exact circles (other
-/// bodies' surfaces kept as they are), and FieldTransfer2D for the state.
+/// bodies' surfaces kept as they are), and LagrangeTransfer<2> for the state.
 ///
 /// Trigger (RemeshOptions): the worst cell quality (Mesh::quality) below `trigger_quality`, or,
 /// with a size function, an edge off its size band (|L - h| / h > adapt.tolerance); with
@@ -79,24 +79,11 @@ class Remesher2D final : public Remesher<2> {
     if (opt_.size) ao.size = opt_.size(circles);
     Mesh<2> m2 = alefsi::adapt(mesh, curves, ao, &last_);
     if (!last_.changed) return std::nullopt;
-    auto T = std::make_unique<Transfer>(mesh, m2, velocity_degree);
+    auto T = std::make_unique<LagrangeTransfer<2>>(mesh, m2, velocity_degree);
     return Remeshed<2>{std::move(m2), std::move(T)};
   }
 
  private:
-  // P1 and P<velocity degree> interpolation plans, built once per remesh.
-  struct Transfer final : MeshTransfer<2> {
-    Transfer(const Mesh<2>& from, const Mesh<2>& to, int degree) : p1(from, to, 1) {
-      if (degree != 1) pk.emplace(from, to, degree);
-    }
-    std::vector<Real> apply(const std::vector<Real>& values, int components, int degree) const override {
-      if (degree == 1) return p1.apply(values, components);
-      ALEFSI_ASSERT(pk && pk->degree() == degree);
-      return pk->apply(values, components);
-    }
-    FieldTransfer2D p1;
-    std::optional<FieldTransfer2D> pk;
-  };
   // the disk bodies as circles at their place at t^n
   static std::vector<Circle> disks(const std::vector<RemeshBody<2>>& bodies) {
     std::vector<Circle> out;

@@ -12,6 +12,8 @@ packages=(cmake ninja-build g++ libeigen3-dev catch2 python3-vtk9 ccache libsuit
 [ "$mode" = test ] && packages+=(clang-14 libclang-rt-14-dev)  # libFuzzer: the readers' fuzz tests
 # PETSc with MPI (optional for the library): the suite runs the PETSc solvers on 1 and 2 ranks
 [ "$mode" = test ] && packages+=(petsc-dev libopenmpi-dev openmpi-bin pkg-config)
+# gmsh's library (optional for the library, GPL): the suite runs the 3D mesher and remesher
+[ "$mode" = test ] && packages+=(libgmsh-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,0 +1,223 @@
+#pragma once
+/// \file mesh/generate/gmsh_mesher.hpp
+/// Tetrahedral meshes of a box with spherical holes (mesh/generate/spheres_in_box.hpp), made by
+/// gmsh's C++ API: the box minus the spheres by OpenCASCADE, surface meshes by Frontal-Delaunay,
+/// the volume by Delaunay with gmsh's optimiser, the size given by a SizeFunction3D (gmsh asks
+/// it at every point it inserts). Needs gmsh (GPL; Debian: libgmsh-dev): link alefsi::gmsh,
+/// which CMake defines when it finds it (ALEFSI_WITH_GMSH); a program linking it is bound by
+/// gmsh's licence.
+///
+/// What comes out: a valid Mesh<3> (cells positively oriented, numbered as gmsh numbered its
+/// nodes, unused nodes dropped), the box's faces tagged BoxDomain::tags, each sphere's facets
+/// its tag, and every node of a sphere's surface exactly on it (projected: |x - c| = r to
+/// round-off), so that a body's surface is its sphere wherever its nodes are placed from its
+/// rigid motion. The same input gives the same mesh (one thread): a run that remeshes restarts
+/// bit for bit from a checkpoint.
+///
+/// gmsh keeps global state: the mesher initialises it for the call and finalises it after (a
+/// program must not hold its own gmsh session across the call). Failures (a gmsh error, a
+/// result below the quality floor) throw MeshError naming the cause; nothing else is changed.
+///
+///     alefsi::GmshMeshReport rep;
+///     auto mesh = alefsi::gmsh_box_mesh(box, spheres, alefsi::graded_size(spheres, 0.05, 0.5), {}, &rep);
+#ifndef ALEFSI_HAVE_GMSH
+#error "alefsi/mesh/generate/gmsh_mesher.hpp needs gmsh's library: link alefsi::gmsh (apt install libgmsh-dev)"
+#endif
+#include <gmsh.h>
+
+#include <chrono>
+#include <map>
+#include <cmath>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "alefsi/core/error.hpp"
+#include "alefsi/mesh/generate/spheres_in_box.hpp"
+#include "alefsi/mesh/mesh.hpp"
+#include "alefsi/mesh/quality.hpp"
+
+namespace alefsi {
+
+struct GmshMeshOptions {
+  Real quality_floor = 0.02;  ///< a mesh whose worst Mesh::quality is below is refused (MeshError)
+  bool netgen = false;        ///< also run gmsh's Netgen optimiser (better worst cells, slower)
+  int verbosity = 0;          ///< gmsh's General.Verbosity (0: silent, 5: everything)
+
+  void validate() const {
+    ALEFSI_CHECK_ARG(quality_floor >= 0 && quality_floor < 1, "quality_floor", "must be in [0, 1), got ",
+                     quality_floor);
+  }
+};
+
+/// What one call made, and what it cost.
+struct GmshMeshReport {
+  Real seconds = 0;  ///< wall time of the call (geometry, meshing, conversion)
+  Index cells = 0, nodes = 0;
+  QualityStats quality;  ///< of the result
+};
+
+namespace detail {
+
+// gmsh for the length of a call: initialised without reading the user's configuration files,
+// silent, one thread, finalised on every way out.
+class GmshSession {
+ public:
+  explicit GmshSession(int verbosity) {
+    gmsh::initialize(0, nullptr, false);
+    gmsh::option::setNumber("General.Terminal", verbosity > 0 ? 1 : 0);
+    gmsh::option::setNumber("General.Verbosity", verbosity);
+    gmsh::option::setNumber("General.NumThreads", 1);
+    gmsh::model::add("alefsi");
+  }
+  ~GmshSession() { gmsh::finalize(); }
+  GmshSession(const GmshSession&) = delete;
+  GmshSession& operator=(const GmshSession&) = delete;
+};
+
+// Which face of the box (0..5: xmin, xmax, ..., zmax) or which sphere (6 + k) an OpenCASCADE
+// surface is, from its centre of mass (a face's is on its plane, a whole sphere's is its
+// centre); -1 if none.
+inline int classify_surface(const BoxDomain& box, const std::vector<Sphere>& spheres, const Vec<3>& centre) {
+  const Real tol = 1e-9 * (box.hi - box.lo).maxCoeff();
+  for (std::size_t k = 0; k < spheres.size(); ++k)
+    if ((centre - spheres[k].centre).norm() < 1e-6 * spheres[k].radius) return 6 + static_cast<int>(k);
+  for (int c = 0; c < 3; ++c) {
+    if (std::abs(centre[c] - box.lo[c]) < tol) return 2 * c;
+    if (std::abs(centre[c] - box.hi[c]) < tol) return 2 * c + 1;
+  }
+  return -1;
+}
+
+inline Mesh<3> gmsh_box_mesh_impl(const BoxDomain& box, const std::vector<Sphere>& spheres, const SizeFunction3D& size,
+                                  const GmshMeshOptions& opt) {
+  GmshSession session(opt.verbosity);
+  namespace occ = gmsh::model::occ;
+  const Vec<3> L = box.hi - box.lo;
+  const int solid = occ::addBox(box.lo[0], box.lo[1], box.lo[2], L[0], L[1], L[2]);
+  gmsh::vectorpair holes, fluid;
+  for (const Sphere& s : spheres) holes.emplace_back(3, occ::addSphere(s.centre[0], s.centre[1], s.centre[2], s.radius));
+  if (holes.empty()) {
+    fluid = {{3, solid}};
+  } else {
+    std::vector<gmsh::vectorpair> map;
+    occ::cut({{3, solid}}, holes, fluid, map);
+  }
+  occ::synchronize();
+  if (fluid.size() != 1 || fluid[0].first != 3)
+    throw MeshError(MeshError::Entity::mesh, -1, "gmsh: the box minus the spheres is not one volume");
+
+  // which tag each surface's triangles get
+  gmsh::vectorpair surfaces;
+  gmsh::model::getEntities(surfaces, 2);
+  std::map<int, int> surface_tag;  // ordered: the facets in the same order every time
+  for (const auto& [dim, s] : surfaces) {
+    double x, y, z;
+    occ::getCenterOfMass(dim, s, x, y, z);
+    const int which = classify_surface(box, spheres, Vec<3>(x, y, z));
+    if (which < 0)
+      throw MeshError(MeshError::Entity::mesh, -1, "gmsh: surface " + std::to_string(s) +
+                                                       " is neither a face of the box nor a sphere");
+    surface_tag[s] = which < 6 ? box.tags[which] : -which;  // spheres: -(6 + k), resolved below
+  }
+
+  gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
+  gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
+  gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+  gmsh::option::setNumber("Mesh.Algorithm", 6);    // Frontal-Delaunay surfaces
+  gmsh::option::setNumber("Mesh.Algorithm3D", 1);  // Delaunay volume
+  gmsh::option::setNumber("Mesh.Optimize", 1);
+  gmsh::option::setNumber("Mesh.OptimizeNetgen", opt.netgen ? 1 : 0);
+  gmsh::model::mesh::setSizeCallback([&size](int, int, double x, double y, double z) { return size(Vec<3>(x, y, z)); });
+  gmsh::model::mesh::generate(3);
+
+  // nodes
+  std::vector<std::size_t> node_tags;
+  std::vector<double> coords, param;
+  gmsh::model::mesh::getNodes(node_tags, coords, param, -1, -1, false, false);
+  std::unordered_map<std::size_t, Index> gmsh_node;  // gmsh tag -> position in coords
+  for (std::size_t i = 0; i < node_tags.size(); ++i) gmsh_node[node_tags[i]] = static_cast<Index>(i);
+
+  // tetrahedra, numbering the nodes they use in the order gmsh numbered them
+  std::vector<std::size_t> tet_tags, tet_nodes;
+  gmsh::model::mesh::getElementsByType(4, tet_tags, tet_nodes, -1);
+  if (tet_tags.empty()) throw MeshError(MeshError::Entity::mesh, -1, "gmsh made no tetrahedra");
+  std::vector<Index> index(node_tags.size(), -1);
+  for (std::size_t t : tet_nodes) index[gmsh_node.at(t)] = 0;
+  std::vector<Vec<3>> x;
+  for (std::size_t i = 0; i < node_tags.size(); ++i)
+    if (index[i] == 0) {
+      index[i] = static_cast<Index>(x.size());
+      x.emplace_back(coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]);
+    }
+  auto node = [&](std::size_t gmsh_tag) {
+    const Index i = index[gmsh_node.at(gmsh_tag)];
+    if (i < 0) throw MeshError(MeshError::Entity::mesh, -1, "gmsh: a surface node is in no tetrahedron");
+    return i;
+  };
+
+  // boundary triangles, and the spheres' nodes put exactly on their spheres
+  std::vector<Mesh<3>::Facet> facets;
+  std::vector<int> facet_tags;
+  for (const auto& [s, t] : surface_tag) {
+    std::vector<std::size_t> tri_tags, tri_nodes;
+    gmsh::model::mesh::getElementsByType(2, tri_tags, tri_nodes, s);
+    const int tag = t >= 0 ? t : spheres[-t - 6].tag;
+    for (std::size_t e = 0; e < tri_tags.size(); ++e) {
+      Mesh<3>::Facet f;
+      for (int j = 0; j < 3; ++j) {
+        f[j] = node(tri_nodes[3 * e + j]);
+        if (t < 0) {
+          const Sphere& sp = spheres[-t - 6];
+          const Vec<3> r = x[f[j]] - sp.centre;
+          x[f[j]] = sp.centre + sp.radius * (r / r.norm());
+        }
+      }
+      facets.push_back(f);
+      facet_tags.push_back(tag);
+    }
+  }
+  std::vector<Mesh<3>::Cell> cells(tet_tags.size());
+  for (std::size_t e = 0; e < cells.size(); ++e) {
+    for (int j = 0; j < 4; ++j) cells[e][j] = node(tet_nodes[4 * e + j]);
+    const Vec<3> a = x[cells[e][0]];
+    if ((x[cells[e][1]] - a).dot((x[cells[e][2]] - a).cross(x[cells[e][3]] - a)) < 0) std::swap(cells[e][2], cells[e][3]);
+  }
+  return Mesh<3>(std::move(x), std::move(cells), facets, facet_tags);
+}
+
+}  // namespace detail
+
+/// A mesh of `box` minus the `spheres` with edge lengths near `size` (file comment). Throws
+/// InvalidArgument naming the body for a scene it cannot mesh (check_spheres_in_box), MeshError
+/// when gmsh fails or the worst cell is below `opt.quality_floor`.
+inline Mesh<3> gmsh_box_mesh(const BoxDomain& box, const std::vector<Sphere>& spheres, const SizeFunction3D& size,
+                             const GmshMeshOptions& opt = {}, GmshMeshReport* report = nullptr) {
+  check_spheres_in_box(box, spheres);
+  opt.validate();
+  ALEFSI_CHECK_ARG(static_cast<bool>(size), "size", "a size function is needed");
+  const auto t0 = std::chrono::steady_clock::now();
+  Mesh<3> mesh;
+  try {
+    mesh = detail::gmsh_box_mesh_impl(box, spheres, size, opt);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw MeshError(MeshError::Entity::mesh, -1, std::string("gmsh failed: ") + e.what());
+  } catch (const std::string& e) {  // gmsh's API throws its last error message
+    throw MeshError(MeshError::Entity::mesh, -1, "gmsh failed: " + e);
+  } catch (...) {
+    throw MeshError(MeshError::Entity::mesh, -1, "gmsh failed");
+  }
+  const QualityStats q = quality_stats(mesh);
+  if (q.worst < opt.quality_floor)
+    throw MeshError(MeshError::Entity::mesh, -1,
+                    detail::concat("the new mesh's worst quality ", q.worst, " is below the floor ", opt.quality_floor,
+                                   " (dihedral angles ", q.min_dihedral_deg, " to ", q.max_dihedral_deg, " degrees)"));
+  if (report)
+    *report = {std::chrono::duration<Real>(std::chrono::steady_clock::now() - t0).count(), mesh.n_cells(),
+               mesh.n_nodes(), q};
+  return mesh;
+}
+
+}  // namespace alefsi

@@ -553,3 +553,40 @@ TEST_CASE("3D scene refusals name the body: a sphere tag missing from a gmsh fil
   wrong(sphere_body(5, Vec<3>::Zero(), 0.25, 1.5), "bodies[0] (tag 5): surface node");
   wrong(sphere_body(5, Vec<3>(0.01, 0, 0), 0.2, 1.5), "bodies[0] (tag 5): surface node");
 }
+
+TEST_CASE("exact buoyancy: a neutrally buoyant sphere in a closed box stays at rest to round-off, where the "
+          "pressure's buoyancy on the inscribed polyhedron lets it sink; open boundaries and non-spheres refused",
+          "[bodies3d][quick]") {
+  // sphere_in_box3d.msh: walls tag 1, a sphere of radius 0.2 at the origin, tag 5, h ~ 0.07 on it
+  using Flow = AleFlow<FlowConfig<3, P1P1Gls, BDF2_BDF2E>>;
+  auto settle = [](Buoyancy b) {
+    Flow flow(gmsh_mesh("sphere_in_box3d.msh"), {.rho = 1, .mu = 0.1});
+    flow.set_velocity(1, [](const Vec<3>&, Real) { return Vec<3>(0, 0, 0); });
+    flow.add_body(sphere_body(5, Vec<3>::Zero(), 0.2, 1.0));  // the fluid's density
+    flow.set_gravity(Vec<3>(0, 0, -10), b);
+    for (int n = 0; n < 3; ++n) flow.step(0.02);
+    return std::pair{flow.body_velocity(0), flow.body_hydrodynamic_load(0)};
+  };
+  const auto [z_exact, load_exact] = settle(Buoyancy::exact);
+  const auto [z_pressure, load_pressure] = settle(Buoyancy::pressure);
+  INFO("exact: Z = " << z_exact.transpose() << "; pressure: Z = " << z_pressure.transpose());
+  // exact: (m - rho_f V) g = 0 and p - rho_f g.x = 0, u = 0 solve the discrete problem
+  CHECK(z_exact.norm() < 1e-12);
+  CHECK(load_exact.norm() < 1e-12);
+  // pressure: the hole holds V_h = 0.945 V, so a weight 0.055 rho_f V g is not carried
+  CHECK(z_pressure[2] < -1e-3);
+  CHECK(z_pressure.head<2>().norm() < 0.05 * std::abs(z_pressure[2]));
+
+  Flow open(gmsh_mesh("sphere_in_box3d.msh"), {.rho = 1, .mu = 0.1});  // tag 1 left natural
+  open.add_body(sphere_body(5, Vec<3>::Zero(), 0.2, 1.0));
+  open.set_gravity(Vec<3>(0, 0, -10), Buoyancy::exact);
+  CHECK_THROWS_AS(open.step(0.02), InvalidArgument);
+  CHECK_THROWS_WITH(open.step(0.02), Catch::Contains("facets with tag 1 have a natural (traction) condition"));
+  Flow cube(gmsh_mesh("sphere_in_box3d.msh"), {.rho = 1, .mu = 0.1});
+  cube.set_velocity(1, [](const Vec<3>&, Real) { return Vec<3>(0, 0, 0); });
+  RigidBody3D shape = anisotropic_body();  // not a sphere (no radius)
+  shape.tag = 5;
+  cube.add_body(shape);
+  cube.set_gravity(Vec<3>(0, 0, -10), Buoyancy::exact);
+  CHECK_THROWS_WITH(cube.step(0.02), Catch::Contains("exact buoyancy needs disks or spheres: bodies[0] (tag 5)"));
+}

@@ -31,6 +31,7 @@
 #include <array>
 #include <limits>
 #include <string>
+#include <numbers>
 #include <vector>
 
 #include "alefsi/core/eigen_sparse.hpp"
@@ -158,6 +159,20 @@ class BodySystem {
           if (cells.empty() || cells.back() != c) cells.push_back(c);
           last = owner[i];
         }
+    }
+  }
+
+  /// Exact buoyancy (AleFlow::set_gravity with Buoyancy::exact): each body's weight becomes
+  /// (m - rho_f V) g, V its exact area (disk: pi r^2) or volume (sphere: 4/3 pi r^3), acting at
+  /// its centre; rho_f = 0 restores m g. Disks and spheres only (others are refused by name:
+  /// their centre of buoyancy is not known to be their centre of mass).
+  void set_displaced_density(Real rho_f) {
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      auto& e = entries_[k];
+      const Real r = M::radius(e.data);
+      ALEFSI_CHECK_ARG(rho_f == 0 || r > 0, "gravity", "exact buoyancy needs disks or spheres: bodies[", k, "] (tag ",
+                       M::tag(e.data), ") is neither");
+      e.displaced = rho_f * (D == 2 ? std::numbers::pi * r * r : 4.0 / 3.0 * std::numbers::pi * r * r * r);
     }
   }
 
@@ -506,6 +521,7 @@ class BodySystem {
     std::vector<Index> dofs_sorted;                 // the same, sorted (driven bodies)
     std::vector<Index> cells;                       // cells with a surface velocity DOF (driven bodies)
     std::vector<typename Mesh<D>::Facet> facets;    // surface facets
+    Real displaced = 0;                             // fluid mass of its exact volume (exact buoyancy), else 0
     // the step's prediction
     Velocity Zhat = Velocity::Zero();               // extrapolated (or given) velocity
     Vec<D> xg_next = Vec<D>::Zero();                // centre at t^{n+1}
@@ -520,7 +536,7 @@ class BodySystem {
   }
   static Velocity weight(const Entry& e, const Vec<D>& gravity) {
     Velocity w = Velocity::Zero();
-    w.template head<D>() = M::mass(e.data) * gravity;
+    w.template head<D>() = (M::mass(e.data) - e.displaced) * gravity;
     return w;
   }
 

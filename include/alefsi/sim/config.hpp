@@ -83,6 +83,11 @@ concept FlowConfiguration = requires {
 static_assert(FlowConfiguration<FlowConfig<2, TaylorHood, BDF2_BDF2E>>);
 
 /// The run-time choices of a flow.
+/// Where the buoyancy of bodies under gravity comes from (AleFlow::set_gravity): the fluid's
+/// hydrostatic pressure on their discrete surfaces, or their exact volume (the hydrostatic
+/// pressure taken out of the pressure; closed domains).
+enum class Buoyancy { pressure, exact };
+
 struct FlowOptions {
   Real rho = 1, mu = 1;
   Linearisation linearisation = Linearisation::newton;

@@ -30,8 +30,8 @@
 #include <algorithm>
 #include <array>
 #include <limits>
-#include <string>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "alefsi/core/eigen_sparse.hpp"
@@ -165,10 +165,12 @@ class BodySystem {
   /// Exact buoyancy (AleFlow::set_gravity with Buoyancy::exact): each body's weight becomes
   /// (m - rho_f V) g, V its exact area (disk: pi r^2) or volume (sphere: 4/3 pi r^3), acting at
   /// its centre; rho_f = 0 restores m g. Disks and spheres only (others are refused by name:
-  /// their centre of buoyancy is not known to be their centre of mass).
+  /// their centre of buoyancy is not known to be their centre of mass). Massless (force-free)
+  /// bodies keep rows without gravity.
   void set_displaced_density(Real rho_f) {
     for (std::size_t k = 0; k < entries_.size(); ++k) {
       auto& e = entries_[k];
+      if (M::mass(e.data) == 0) continue;
       const Real r = M::radius(e.data);
       ALEFSI_CHECK_ARG(rho_f == 0 || r > 0, "gravity", "exact buoyancy needs disks or spheres: bodies[", k, "] (tag ",
                        M::tag(e.data), ") is neither");

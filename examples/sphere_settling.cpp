@@ -41,10 +41,7 @@
 #include <alefsi/la/petsc.hpp>
 #endif
 
-#include <sys/resource.h>
-
 #include <chrono>
-#include <ctime>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -86,12 +83,6 @@ bool parse(int argc, char** argv, Settings& o) {
   return opt.parse(argc, argv, std::cout);
 }
 
-Real cpu_seconds() { return Real(std::clock()) / CLOCKS_PER_SEC; }
-Real peak_mb() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return Real(u.ru_maxrss) / 1024;
-}
 
 }  // namespace
 
@@ -104,7 +95,7 @@ int settling_main(int argc, char** argv) try {
   Settings o;
   if (!parse(argc, argv, o)) return 0;
   const auto wall0 = std::chrono::steady_clock::now();
-  const Real cpu0 = cpu_seconds();
+  const Real cpu0 = app::cpu_seconds();
   o.scene.start = alefsi::Vec<3>(0, 0, o.start_z);
   const scenes::SettlingSphere& scene = o.scene;
   const auto checkpoint = o.output / "checkpoint.bin";
@@ -134,7 +125,7 @@ int settling_main(int argc, char** argv) try {
             << "  " << sum.steps << " steps, last solve " << flow.solver().iterations() << " iterations; wall "
             << std::setprecision(3)
             << std::chrono::duration<Real>(std::chrono::steady_clock::now() - wall0).count() << " s, CPU "
-            << cpu_seconds() - cpu0 << " s, peak " << std::setprecision(0) << std::fixed << peak_mb()
+            << app::cpu_seconds() - cpu0 << " s, peak " << std::setprecision(0) << std::fixed << app::peak_mb()
             << " MB (this rank); files in " << o.output.string() << "\n"
             << std::setprecision(2) << "  phases (rank 0): mesh velocity " << sum.t_mesh_velocity << " s, assembly "
             << sum.t_assembly << " s (" << flow.assembled_cells() << " of " << flow.mesh().n_cells()

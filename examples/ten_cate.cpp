@@ -29,10 +29,7 @@
 #include <alefsi/la/krylov.hpp>
 #include <alefsi/sim/remesher3d.hpp>
 
-#include <sys/resource.h>
-
 #include <chrono>
-#include <ctime>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -86,12 +83,6 @@ bool parse(int argc, char** argv, Settings& o) {
   return opt.parse(argc, argv, std::cout);
 }
 
-Real cpu_seconds() { return Real(std::clock()) / CLOCKS_PER_SEC; }
-Real peak_mb() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return Real(u.ru_maxrss) / 1024;
-}
 
 }  // namespace
 
@@ -102,7 +93,7 @@ int main(int argc, char** argv) try {
   ALEFSI_CHECK_ARG(o.level >= 1 && o.level <= 6, "level", "must be in 1..6, got ", o.level);
   const Oil oil = oils.at(o.oil);
   const auto wall0 = std::chrono::steady_clock::now();
-  const Real cpu0 = cpu_seconds();
+  const Real cpu0 = app::cpu_seconds();
 
   const Real h_body = D / (4 + 4 * o.level), h_far = std::min(8 * h_body, 0.01);
   const Real grading = o.grading;
@@ -153,8 +144,8 @@ int main(int argc, char** argv) try {
               << " cells, worst quality " << r.before.worst << " -> " << r.mesher.quality.worst << "\n";
   std::cout << "  " << sum.steps << " steps (" << sum.rejected << " rejected, dt " << sum.dt_smallest << " to "
             << sum.dt_largest << " s), " << sum.remeshes << " remeshes, worst quality " << sum.worst_quality
-            << "; wall " << wall << " s, CPU " << cpu_seconds() - cpu0 << " s, peak " << std::setprecision(0)
-            << std::fixed << peak_mb() << " MB\n"
+            << "; wall " << wall << " s, CPU " << app::cpu_seconds() - cpu0 << " s, peak " << std::setprecision(0)
+            << std::fixed << app::peak_mb() << " MB\n"
             << std::setprecision(1) << "  phases: mesh velocity " << sum.t_mesh_velocity << " s, assembly "
             << sum.t_assembly << " s, preconditioner set-up " << sum.t_factorize << " s, solves " << sum.t_solve
             << " s, remeshing " << sum.t_remesh << " s\n";

@@ -1,4 +1,6 @@
 #pragma once
 /// \file app.hpp
-/// Helpers for programs built on alefsi: the command-line options parser.
+/// Helpers for programs built on alefsi: the command-line options parser, the process's CPU
+/// time and peak memory.
 #include "alefsi/app/options.hpp"
+#include "alefsi/app/resources.hpp"

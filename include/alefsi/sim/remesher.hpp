@@ -21,6 +21,8 @@
 /// Remeshers: `Remesher2D` (sim/remesher2d.hpp: split / collapse / flip / smoothing with disks on
 /// their exact circles) and `Remesher3D` (sim/remesher3d.hpp: a new mesh of the box with its
 /// spheres from gmsh, when alefsi::gmsh is linked). Both transfer by `LagrangeTransfer<D>`.
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -95,6 +97,28 @@ class Remesher {
   virtual std::optional<Remeshed<D>> adapt(const Mesh<D>& mesh, const std::vector<RemeshBody<D>>& bodies,
                                            int velocity_degree) = 0;
 };
+
+/// Worst relative deviation |L - h| / h of an edge's length L from the size function h at its
+/// midpoint (the size trigger of both remeshers).
+template <int D, class SizeFn>
+Real size_deviation(const Mesh<D>& mesh, const SizeFn& h) {
+  Real dev = 0;
+  for (const auto& e : mesh.edges()) {
+    const Vec<D> a = mesh.node(e[0]), c = mesh.node(e[1]);
+    const Real E = h(0.5 * (a + c));
+    dev = std::max(dev, std::abs((a - c).norm() - E) / E);
+  }
+  return dev;
+}
+
+/// The trigger of both remeshers, with hysteresis: the worst quality below `trigger_quality`,
+/// or (`sized`: there is a size function) an edge off its band |L - h| / h > `tolerance`; what
+/// the last remesh left (`last`) triggers again only once it got worse by 10 %.
+inline bool remesh_due(const RemeshMemory& now, const RemeshMemory& last, Real trigger_quality, Real tolerance,
+                       bool sized) {
+  return now.quality < std::min(trigger_quality, 0.9 * last.quality) ||
+         (sized && now.deviation > std::max(tolerance, 1.1 * last.deviation));
+}
 
 /// Smallest Mesh::quality over the cells.
 template <int D>

@@ -51,23 +51,11 @@ class Remesher2D final : public Remesher<2> {
   const AdaptReport& last_report() const { return last_; }
 
   RemeshMemory measure(const Mesh<2>& mesh, const std::vector<RemeshBody<2>>& bodies) const override {
-    Real dev = 0;
-    if (opt_.size) {
-      const SizeFunction h = opt_.size(disks(bodies));
-      for (const auto& e : mesh.edges()) {
-        const Vec<2> a = mesh.node(e[0]), c = mesh.node(e[1]);
-        const Real E = h(0.5 * (a + c));
-        dev = std::max(dev, std::abs((a - c).norm() - E) / E);
-      }
-    }
-    return {worst_quality(mesh), dev};
+    return {worst_quality(mesh), opt_.size ? size_deviation(mesh, opt_.size(disks(bodies))) : Real(0)};
   }
 
   bool needed(const Mesh<2>& mesh, const std::vector<RemeshBody<2>>& bodies, const RemeshMemory& last) const override {
-    const auto [q, dev] = measure(mesh, bodies);
-    const Real q_lim = std::min(opt_.trigger_quality, 0.9 * last.quality);
-    const Real dev_lim = std::max(opt_.adapt.tolerance, 1.1 * last.deviation);
-    return q < q_lim || (opt_.size && dev > dev_lim);
+    return remesh_due(measure(mesh, bodies), last, opt_.trigger_quality, opt_.adapt.tolerance, bool(opt_.size));
   }
 
   std::optional<Remeshed<2>> adapt(const Mesh<2>& mesh, const std::vector<RemeshBody<2>>& bodies,

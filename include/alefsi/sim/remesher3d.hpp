@@ -75,19 +75,11 @@ class Remesher3D final : public Remesher<3> {
   const std::vector<Remesh3DReport>& reports() const { return reports_; }
 
   RemeshMemory measure(const Mesh<3>& mesh, const std::vector<RemeshBody<3>>& bodies) const override {
-    const SizeFunction3D h = opt_.size(spheres(bodies));
-    Real dev = 0;
-    for (const auto& e : mesh.edges()) {
-      const Vec<3> a = mesh.node(e[0]), c = mesh.node(e[1]);
-      const Real E = h(0.5 * (a + c));
-      dev = std::max(dev, std::abs((a - c).norm() - E) / E);
-    }
-    return {worst_quality(mesh), dev};
+    return {worst_quality(mesh), size_deviation(mesh, opt_.size(spheres(bodies)))};
   }
 
   bool needed(const Mesh<3>& mesh, const std::vector<RemeshBody<3>>& bodies, const RemeshMemory& last) const override {
-    const auto [q, dev] = measure(mesh, bodies);
-    return q < std::min(opt_.trigger_quality, 0.9 * last.quality) || dev > std::max(opt_.tolerance, 1.1 * last.deviation);
+    return remesh_due(measure(mesh, bodies), last, opt_.trigger_quality, opt_.tolerance, true);
   }
 
   std::optional<Remeshed<3>> adapt(const Mesh<3>& mesh, const std::vector<RemeshBody<3>>& bodies,

@@ -132,7 +132,7 @@ TEST_CASE("3D eq. (24) + spring on spheres: magnitude, direction, action = react
   CHECK(c[0].gap == Approx(d).epsilon(1e-12));
   const Vec<3> F = CollisionModel<3>::force(c[0], b);
   const Real s = 1 - d / 0.04;
-  const Real expected = mu * std::pow(4 * R / d, 1.5) * (b[1].velocity - b[0].velocity).norm() + 3 * s * s;
+  const Real expected = mu * R * std::pow(4 * R / d, 1.5) * (b[1].velocity - b[0].velocity).norm() + 3 * s * s;
   CHECK(F.norm() == Approx(expected).epsilon(1e-12));
   CHECK(F.dot(b[c[0].k].centre - b[c[0].j].centre) > 0);  // repulsive
   CHECK((F.normalized() - c[0].normal).norm() < 1e-14);
@@ -151,7 +151,78 @@ TEST_CASE("3D eq. (24) + spring on spheres: magnitude, direction, action = react
   CHECK(w[0].j == -1);
   CHECK(w[0].normal.isApprox(Vec<3>(-1, 0, 0)));
   const Real sw = 1 - 0.01 / 0.04;
-  CHECK(CollisionModel<3>::force(w[0], b)[0] == Approx(-(mu * std::pow(4 * R / 0.01, 1.5) * 0.5 + 3 * sw * sw)).epsilon(1e-12));
+  CHECK(CollisionModel<3>::force(w[0], b)[0] == Approx(-(mu * R * std::pow(4 * R / 0.01, 1.5) * 0.5 + 3 * sw * sw)).epsilon(1e-12));
+}
+
+TEST_CASE("eq. (24) is a force in both unit systems: the same contact in SI and in cgs, 2D and 3D",
+          "[collision][quick]") {
+  // ten Cate's E4 sphere (R = 7.5 mm, mu = 0.058 Pa s) 0.5 mm above the floor, falling at
+  // 0.09 m/s. In cgs: R = 0.75 cm, mu = 0.58 g / (cm s), V = 9 cm/s, and 1 N = 1e5 dyn (3D);
+  // a force per unit length in 2D, 1 N/m = 1e3 dyn/cm
+  auto floor_force = [](auto dim, Real L, Real mu, Real R, Real gap, Real v) {
+    constexpr int D = decltype(dim)::value;
+    CollisionModel<D> model({.range = 0.1});
+    Vec<D> c = Vec<D>::Constant(L / 2), vel = Vec<D>::Zero();
+    c[D - 1] = R + gap, vel[D - 1] = -v;
+    if constexpr (D == 3) model.set_walls(box_walls(L));
+    else model.set_walls({{Vec<2>(0, 0), Vec<2>(L, 0)}});
+    const std::vector<CollisionBody<D>> b = {ball<D>(c, R, vel)};
+    const auto contact = model.contacts(b, mu);
+    REQUIRE(contact.size() == 1);
+    return CollisionModel<D>::force(contact[0], b)[D - 1];
+  };
+  const Real si3 = floor_force(std::integral_constant<int, 3>{}, 0.1, 0.058, 7.5e-3, 5e-4, 0.09);
+  const Real cgs3 = floor_force(std::integral_constant<int, 3>{}, 10, 0.58, 0.75, 0.05, 9);
+  CHECK(si3 > 0);
+  CHECK(cgs3 == Approx(1e5 * si3).epsilon(1e-12));
+  const Real si2 = floor_force(std::integral_constant<int, 2>{}, 0.1, 0.058, 7.5e-3, 5e-4, 0.09);
+  const Real cgs2 = floor_force(std::integral_constant<int, 2>{}, 10, 0.58, 0.75, 0.05, 9);
+  CHECK(cgs2 == Approx(1e3 * si2).epsilon(1e-12));
+  // and at d = delta the 3D force is within a factor 1.35 of the sphere-plane lubrication force
+  // 6 pi mu R^2 V / d (Brenner 1961): 40^{3/2} = 253 against 60 pi = 188
+  const Real at_delta = floor_force(std::integral_constant<int, 3>{}, 0.1, 0.058, 7.5e-3, 7.5e-4 * (1 - 1e-12), 0.09);
+  const Real lubrication = 6 * std::numbers::pi * 0.058 * 7.5e-3 * 7.5e-3 * 0.09 / 7.5e-4;
+  CHECK(at_delta / lubrication == Approx(std::pow(40, 1.5) / (60 * std::numbers::pi)).epsilon(1e-9));
+}
+
+TEST_CASE("CollisionLaw::lubrication: the signed normal velocity; it resists separation, never adds energy, "
+          "and ignores sliding",
+          "[collision][quick]") {
+  const Real R = 0.5, mu = 0.2, d = 0.02;
+  CollisionModel<3> model({.range = 0.1, .law = CollisionLaw::lubrication});
+  const Vec<3> n = Vec<3>(1, -2, 2).normalized();
+  std::vector<CollisionBody<3>> b = {ball<3>(Vec<3>(2, 2, 2), R), ball<3>(Vec<3>(2, 2, 2) + (2 * R + d) * n, R)};
+  const Real c = mu * R * std::pow(4 * R / d, 1.5);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<Real> U(-1, 1);
+  for (int trial = 0; trial < 20; ++trial) {
+    b[0].velocity = Vec<3>(U(rng), U(rng), U(rng)), b[1].velocity = Vec<3>(U(rng), U(rng), U(rng));
+    const auto contact = model.contacts(b, mu);
+    REQUIRE(contact.size() == 1);
+    const Contact<3>& k = contact[0];
+    const Vec<3> F = CollisionModel<3>::force(k, b);
+    const Vec<3> w = b[k.j].velocity - b[k.k].velocity;
+    CHECK((F - c * w.dot(k.normal) * k.normal).norm() < 1e-12 * c);
+    CHECK(F.dot(-w) <= 1e-14 * c);  // the power on the pair, F_K . (V^K - V^J), is never positive
+    const Mat<3> J = CollisionModel<3>::dforce_dvk(k, b);
+    for (int j = 0; j < 3; ++j) {
+      auto bp = b, bm = b;
+      bp[k.k].velocity[j] += 1e-7, bm[k.k].velocity[j] -= 1e-7;
+      const Vec<3> fd = (CollisionModel<3>::force(k, bp) - CollisionModel<3>::force(k, bm)) / 2e-7;
+      for (int i = 0; i < 3; ++i) CHECK(J(i, j) == Approx(fd[i]).epsilon(1e-6).margin(1e-9 * c));
+    }
+  }
+  // separating along n: attractive (towards J), where the paper's law pushes them apart
+  const auto contact = model.contacts(b, mu);
+  const int k = contact[0].k, j = contact[0].j;
+  b[k].velocity = 0.1 * contact[0].normal, b[j].velocity.setZero();
+  CHECK(CollisionModel<3>::force(contact[0], b).dot(contact[0].normal) == Approx(-0.1 * c).epsilon(1e-12));
+  Contact<3> paper = contact[0];
+  paper.law = CollisionLaw::paper;
+  CHECK(CollisionModel<3>::force(paper, b).dot(contact[0].normal) == Approx(0.1 * c).epsilon(1e-12));
+  // sliding past each other: no force
+  b[k].velocity = n.cross(Vec<3>(0, 0, 1)).normalized();
+  CHECK(CollisionModel<3>::force(contact[0], b).norm() < 1e-12 * c);
 }
 
 TEST_CASE("3D search: the grid finds exactly the sphere pairs a brute-force loop finds", "[collision][quick]") {

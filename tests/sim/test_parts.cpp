@@ -360,8 +360,9 @@ TEST_CASE("CollisionContact<3>: spheres in a box through the seam, momentum bala
     CHECK(arm.norm() == 0.0);  // spheres: through the centres
   });
   const Real s_pair = 1 - d / 0.03, s_floor = 1 - 0.02 / 0.03;
-  const Real pair = mu * std::pow(4 * R / d, 1.5) * (v[1] - v[0]).norm() + 2 * s_pair * s_pair;
-  const Real floor = mu * std::pow(4 * R / 0.02, 1.5) * v[0].norm() + 2 * s_floor * s_floor;
+  // eq. (24) in 3D: mu Rbar (4 Rbar / d)^{3/2} |V^J - V^K| (physics/collision.hpp)
+  const Real pair = mu * R * std::pow(4 * R / d, 1.5) * (v[1] - v[0]).norm() + 2 * s_pair * s_pair;
+  const Real floor = mu * R * std::pow(4 * R / 0.02, 1.5) * v[0].norm() + 2 * s_floor * s_floor;
   CHECK((F[1] - pair * n).norm() < 1e-12 * pair);               // the upper sphere: pushed along n
   CHECK((F[0] + pair * n - floor * Vec<3>::UnitZ()).norm() < 1e-12 * pair);  // the lower: -n, and up from the floor
   CHECK((F[0] + F[1] - floor * Vec<3>::UnitZ()).norm() < 1e-12 * pair);      // action = reaction between them

@@ -5,18 +5,27 @@
 /// points towards J).
 ///
 /// For bodies K and J whose surfaces are a distance d apart, d <= delta:
-///     F_K = mu (4 Rbar / d)^{3/2} |V^J - V^K| n_JK,     F_J = -F_K,
+///     F_K = mu (4 Rbar / d)^{3/2} |V^J - V^K| n_JK,     F_J = -F_K        (2D, per unit length)
+///     F_K = mu Rbar (4 Rbar / d)^{3/2} |V^J - V^K| n_JK                    (3D),
 /// with n_JK = (X_g^K - X_g^J) / |X_g^K - X_g^J| the unit vector from J's centre to K's,
 /// Rbar = min(Rbar^K, Rbar^J), Rbar^K the smallest distance from X_g^K to K's surface and
-/// delta = `range` * Rbar (the paper's delta = Rbar / 10). A wall is a body J with V^J = 0 and
-/// Rbar = Rbar^K; n points from the wall point nearest to the body towards X_g^K. Between
-/// disks/spheres, and a disk/sphere and a wall, the force acts at the centre of mass (its line
-/// passes through it). For other shapes (facet surfaces) the model is generalised to the
-/// contact point: n is the unit vector from J's nearest surface point to K's (the centres'
-/// direction if they coincide), and the force acts at their midpoint, so it carries a torque
-/// (`arm_k`, `arm_j`: from each centre to that point). The gap entering the magnitude is floored at
-/// `min_gap` * delta, so an overlap (d <= 0, which the force is there to prevent) gives a
-/// large but finite force instead of a NaN.
+/// delta = `range` * Rbar (the paper's delta = Rbar / 10). The paper derives eq. (24) from the
+/// lubrication of two planar faces in 2D, where mu |V| is a force per unit length; in 3D a force
+/// needs one more length, and Rbar is the model's only one (without it the force would change
+/// with the unit system: x100 from cm to m). At d = delta it is then 253 mu Rbar |V|, against
+/// 188 mu R |V| from the sphere-plane lubrication law 6 pi mu R^2 |V| / d (Brenner 1961).
+/// A wall is a body J with V^J = 0 and Rbar = Rbar^K; n points from the wall point nearest to
+/// the body towards X_g^K. Between disks/spheres, and a disk/sphere and a wall, the force acts
+/// at the centre of mass (its line passes through it). For other shapes (facet surfaces) the
+/// model is generalised to the contact point: n is the unit vector from J's nearest surface
+/// point to K's (the centres' direction if they coincide), and the force acts at their
+/// midpoint, so it carries a torque (`arm_k`, `arm_j`: from each centre to that point). The gap
+/// entering the magnitude is floored at `min_gap` * delta, so an overlap (d <= 0, which the
+/// force is there to prevent) gives a large but finite force instead of a NaN.
+///
+/// `law`: the magnitude reads |V^J - V^K| (`CollisionLaw::paper`, the default) or the signed
+/// normal part (V^J - V^K) . n_JK (`CollisionLaw::lubrication`: resists separation as it resists
+/// approach, and never adds energy).
 ///
 /// Optional safeguard (off by default): the repulsive spring of Glowinski et al. (1999,
 /// J. Comput. Phys. 169) used in most DKT studies, F_K += F_0 (1 - d / rho)^2 n_JK for
@@ -58,12 +67,25 @@
 
 namespace alefsi {
 
+/// How eq. (24)'s magnitude reads the relative velocity w = V^J - V^K of a contact.
+enum class CollisionLaw {
+  /// |w|: the paper's eq. (24), its sign made repulsive. It pushes the bodies apart also while
+  /// they separate, so a contact can give back more energy than it took (a sphere landing on a
+  /// spring rebounds faster).
+  paper,
+  /// w . n, signed: it resists approach (repulsive) and separation (attractive) alike, as a
+  /// lubrication film does, and never adds energy (F_K . (V^K - V^J) <= 0); sliding (w normal
+  /// to n) gives none.
+  lubrication
+};
+
 struct CollisionOptions {
   Real range = 0.1;     ///< delta = range * Rbar (paper: 1/10); > 0
   bool walls = true;    ///< also between bodies and walls
   Real min_gap = 1e-3;  ///< the gap in the magnitude is floored at min_gap * delta; in (0, 1]
   Real spring_range = 0;  ///< rho of the safeguard spring (length); 0: no spring
   Real spring_force = 0;  ///< F_0: the spring's force at contact (d = 0)
+  CollisionLaw law = CollisionLaw::paper;  ///< how eq. (24) reads the relative velocity
 
   void validate() const {
     ALEFSI_CHECK_ARG(spring_range >= 0 && std::isfinite(spring_range), "collision.spring_range",
@@ -109,11 +131,12 @@ template <int D>
 struct Contact {
   int k = -1, j = -1;
   Real gap = 0;                    ///< d (may be <= 0 for an overlap)
-  Real coefficient = 0;            ///< mu (4 Rbar / max(d, min_gap delta))^{3/2}, 0 when d > delta
+  Real coefficient = 0;            ///< mu (4 Rbar / max(d, min_gap delta))^{3/2} (x Rbar in 3D), 0 when d > delta
   Real spring = 0;                 ///< F_0 (1 - d / rho)^2 (d floored at 0), 0 when d >= rho
   Vec<D> normal = Vec<D>::Zero();  ///< unit, towards K (file comment)
   Vec<D> arm_k = Vec<D>::Zero();   ///< from X_g^K to the point of action (0: through the centre)
   Vec<D> arm_j = Vec<D>::Zero();   ///< from X_g^J to it (0 for a wall)
+  CollisionLaw law = CollisionLaw::paper;
 };
 using Contact2D = Contact<2>;
 
@@ -506,11 +529,14 @@ class CollisionModel {
 
   /// The force on body k of contact c (on body j it is the opposite).
   static Vec<D> force(const Contact<D>& c, const std::vector<CollisionBody<D>>& bodies) {
-    return (c.coefficient * relative_velocity(c, bodies).norm() + c.spring) * c.normal;
+    const Vec<D> w = relative_velocity(c, bodies);
+    const Real speed = c.law == CollisionLaw::paper ? w.norm() : w.dot(c.normal);
+    return (c.coefficient * speed + c.spring) * c.normal;
   }
   /// d F_k / d V^k (D x D); d F_k / d V^j = -(d F_k / d V^k); at |V^J - V^K| = 0 the
   /// derivative of the norm is taken as 0.
   static Mat<D> dforce_dvk(const Contact<D>& c, const std::vector<CollisionBody<D>>& bodies) {
+    if (c.law == CollisionLaw::lubrication) return -c.coefficient * c.normal * c.normal.transpose();
     const Vec<D> w = relative_velocity(c, bodies);
     const Real n = w.norm();
     if (n == 0) return Mat<D>::Zero();
@@ -526,8 +552,10 @@ class CollisionModel {
   Contact<D> make(const Proximity<D>& p, Real mu) const {
     const Real delta = opt_.range * p.rbar;
     const Real d = std::max(p.gap, opt_.min_gap * delta);
-    Contact<D> c{p.k,    p.j, p.gap, p.gap <= delta ? mu * std::pow(4 * p.rbar / d, 1.5) : 0.0, 0.0, p.normal,
-                 p.arm_k, p.arm_j};
+    // 2D: a force per unit length, mu |V| times a number; 3D: times the length Rbar
+    const Real scale = D == 3 ? mu * p.rbar : mu;
+    Contact<D> c{p.k,    p.j, p.gap, p.gap <= delta ? scale * std::pow(4 * p.rbar / d, 1.5) : 0.0, 0.0, p.normal,
+                 p.arm_k, p.arm_j, opt_.law};
     if (p.gap < opt_.spring_range) {
       const Real s = 1 - std::max(p.gap, Real(0)) / opt_.spring_range;
       c.spring = opt_.spring_force * s * s;

@@ -411,6 +411,50 @@ TEST_CASE("SaddlePointGmres solves 3D Stokes (P2/P1, P1/P1-GLS) and agrees with 
   CHECK_THROWS_AS(k.analyze(spd), SolverError);  // no saddle point: nothing to call pressure
 }
 
+TEST_CASE("SaddlePointGmres keeps its set-up for later matrices of the same pattern (LinearSolve)",
+          "[la][solvers][krylov][reuse][quick]") {
+  static_assert(ReusableSetUp<SaddlePointGmres<3>>);
+  static_assert(!ReusableSetUp<BiCgStabIlut> && !ReusableSetUp<SparseLu<>>);
+  const auto s = cavity3d<TaylorHood>(4);
+  const Index nu = s.A.rows() - s.blocks.n_pressure;  // velocities first, then the pressures
+  auto drifted = [&](Real eps) {  // a mass-like term that changes, the pattern unchanged
+    SparseMatrix A = s.A;
+    for (Index k = 0; k < nu; ++k) A.coeffRef(k, k) *= 1 + eps;
+    return A;
+  };
+  KrylovOptions opt;
+  opt.tolerance = 1e-10;
+  LinearSolve<SaddlePointGmres<3>> lin(opt);
+  lin.solver().set_blocks(s.blocks);
+  lin.set_reuse({.enabled = true});
+  REQUIRE(lin.reuse().enabled);
+  LinearSolveCounts counts;
+  const SparseMatrix A0 = drifted(0);
+  lin.factorize(A0);
+  CHECK(relative_residual(A0, lin.solve(A0, s.b, counts), s.b) <= opt.tolerance);
+  CHECK(counts.iterative_solves == 1);
+  const int fresh = counts.iterative_iterations;
+  for (Real eps : {0.01, 0.02}) {
+    const SparseMatrix A = drifted(eps);
+    REQUIRE(lin.reusable());
+    const VecX x = lin.solve(A, s.b, counts);  // the products with A, the preconditioner of A0
+    CHECK(relative_residual(A, x, s.b) <= opt.tolerance);
+    const VecX reference = solve_with<SparseLu<>>(A, s.b);
+    CHECK((x - reference).norm() <= 1e-7 * reference.norm());
+  }
+  std::cout << "SaddlePointGmres, one set-up for three matrices: " << fresh << " iterations, then "
+            << counts.iterative_iterations - fresh << " for the two others\n";
+  CHECK(counts.factorisations == 0);  // (the first one was called directly)
+  CHECK(counts.reused == 2);
+  CHECK(counts.iterative_solves == 3);
+  CHECK(lin.factored_values().size() == 0);  // nothing for a checkpoint: the flow drops it per step
+  lin.drop();
+  CHECK(!lin.reusable());
+  // another pattern is refused by name
+  const SparseMatrix small = s.A.topLeftCorner(nu, nu);
+  CHECK_THROWS_WITH(lin.solver().solve(small, VecX::Ones(nu)), Catch::Contains("pattern"));
+}
+
 TEST_CASE("SaddlePointGmres: iteration counts under refinement (Schur approximations are mesh-independent)",
           "[la][solvers][krylov][quick]") {
   // Taylor–Hood with exact velocity solves (the AMG's coarsest level holds the whole block):
@@ -461,6 +505,12 @@ TEST_CASE("AleFlow with SaddlePointGmres: a 3D Navier–Stokes step with a free 
   run(direct);
   const StepReport rep = run(krylov);
   CHECK(rep.newton_iterations <= 4);  // GMRES to 1e-8 per Newton update, Newton to 1e-10
+  // the preconditioner is set up at the step's first Newton iteration and serves the others
+  CHECK(rep.newton_iterations >= 2);
+  CHECK(rep.linear.factorisations == 1);
+  CHECK(rep.linear.reused == rep.newton_iterations - 1);
+  CHECK(rep.linear.iterative_solves == rep.newton_iterations);
+  CHECK(rep.linear.iterative_iterations >= rep.linear.iterative_solves);
   const VecX& u0 = direct.field();
   const VecX& u1 = krylov.field();
   CHECK((u1 - u0).norm() <= 1e-7 * u0.norm());

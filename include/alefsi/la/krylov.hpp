@@ -195,6 +195,16 @@ class SaddlePointGmres {
     work_.V.resize(0, 0);
   }
 
+  /// Solves A x = b with the preconditioner set up for an earlier matrix of the same pattern
+  /// (its AMG hierarchies, body elimination and Schur approximation; the products are with A).
+  /// A must stay alive and unchanged until the last solve, as for `factorize`.
+  VecX solve(const SparseMatrix& A, const VecX& b) {
+    ALEFSI_CHECK_ARG(A_ && A.rows() == n_ && A.nonZeros() == A_->nonZeros(), "A",
+                     "must have the pattern of the matrix the preconditioner was set up for");
+    A_ = &A;
+    return solve(b);
+  }
+
   VecX solve(const VecX& b) {
     if (!A_) throw SolverError(std::string(name) + ": solve before factorize");
     ALEFSI_CHECK_ARG(b.size() == n_, "b", "has ", b.size(), " entries, expected ", n_);

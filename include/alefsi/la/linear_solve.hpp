@@ -3,13 +3,17 @@
 /// A linear solver policy (la/solvers.hpp) with the state of its symbolic analysis and, for
 /// direct solvers, the reuse of a factorisation across solves of slowly changing matrices
 /// (Newton iterations, time steps): `LinearSolve::solve(J, r, counts)` factorises J, or solves
-/// it by GMRES (la/gmres.hpp) preconditioned by the factors of an earlier matrix. The flow's
+/// it by GMRES (la/gmres.hpp) preconditioned by the factors of an earlier matrix. An iterative
+/// solver that can solve with a new matrix on the preconditioner at hand (`solve(A, b)`,
+/// `ReusableSetUp`: SaddlePointGmres) keeps its set-up likewise, until `drop()` (the flow drops
+/// it at every step: its Schur approximation holds the step's dt). The flow's
 /// Newton solve (sim/newton.hpp) and the mesh-velocity problem (physics/mesh_motion.hpp) use it.
 ///
 ///     LinearSolve<SparseLu<>> lin;
 ///     lin.set_reuse({.enabled = true});
 ///     if (!lin.reusable()) lin.factorize(J);
 ///     VecX x = lin.solve(J, r, counts);
+#include <concepts>
 #include <utility>
 
 #include "alefsi/core/eigen_sparse.hpp"
@@ -34,13 +38,24 @@ struct FactorisationReuse {
 /// What the linear solves did (a Newton solve's, summed per step in StepReport; a mesh-velocity
 /// solver's since it was built).
 struct LinearSolveCounts {
-  int factorisations = 0;     ///< numeric factorisations
+  int factorisations = 0;     ///< numeric factorisations (an iterative solver's set-ups)
   int reused = 0;             ///< solves by GMRES on an earlier factorisation
   int krylov_iterations = 0;  ///< their GMRES iterations
+  int iterative_solves = 0;      ///< solves by an iterative solver (one with `iterations()`)
+  int iterative_iterations = 0;  ///< their iterations
   LinearSolveCounts& operator+=(const LinearSolveCounts& o) {
     factorisations += o.factorisations, reused += o.reused, krylov_iterations += o.krylov_iterations;
+    iterative_solves += o.iterative_solves, iterative_iterations += o.iterative_iterations;
     return *this;
   }
+};
+
+/// An iterative solver whose preconditioner, set up by `factorize` for one matrix, can serve a
+/// later matrix of the same pattern: `solve(A, b)`.
+template <class S>
+concept ReusableSetUp = LinearSolver<S> && !DirectSolver<S> && requires(S s, const SparseMatrix& A, const VecX& b) {
+  { s.solve(A, b) } -> std::convertible_to<VecX>;
+  { s.iterations() } -> std::convertible_to<int>;
 };
 
 /// A linear solver policy (constructed in place: solvers such as SparseLu cannot be moved), the
@@ -52,12 +67,14 @@ class LinearSolve {
  public:
   template <class... Args>
   explicit LinearSolve(Args&&... args) : solver_(std::forward<Args>(args)...) {}
-  /// Reuse on or off (always off for iterative solvers).
+  /// Reuse on or off (always off for iterative solvers without `ReusableSetUp`).
   void set_reuse(const FactorisationReuse& r) {
     reuse_ = r;
-    if constexpr (!DirectSolver<S>) reuse_.enabled = false;
+    if constexpr (!DirectSolver<S> && !ReusableSetUp<S>) reuse_.enabled = false;
     if (!reuse_.enabled) factored_ = false;
   }
+  /// The next solve sets up afresh (the factors or preconditioner at hand are not reused).
+  void drop() { factored_ = false, factored_values_.resize(0), analysed_values_.resize(0); }
   const FactorisationReuse& reuse() const { return reuse_; }
   /// The sparsity pattern changed: analyse again before the next factorisation.
   void reset() {
@@ -66,14 +83,17 @@ class LinearSolve {
     analysed_values_.resize(0), factored_values_.resize(0);
   }
   void factorize(const SparseMatrix& J) {
+    // the matrices' values are kept for checkpoints (direct solvers: an iterative solver's
+    // set-up is dropped at every step, so a checkpoint between steps has none)
+    constexpr bool keep = DirectSolver<S>;
     if (!analysed_) {
       solver_.analyze(J);
       analysed_ = true;
-      if (reuse_.enabled) analysed_values_ = values(J);
+      if (keep && reuse_.enabled) analysed_values_ = values(J);
     }
     solver_.factorize(J);
     factored_ = reuse_.enabled, fresh_ = true, refactor_next_ = false;
-    if (reuse_.enabled) factored_values_ = values(J);
+    if (keep && reuse_.enabled) factored_values_ = values(J);
   }
   /// The next solve of a new matrix can use the factors at hand (no factorisation first).
   bool reusable() const { return reuse_.enabled && factored_ && !refactor_next_; }
@@ -84,7 +104,31 @@ class LinearSolve {
     if (fresh_ || !reusable()) {
       if (!fresh_) factorize(J), ++counts.factorisations;
       fresh_ = false;
-      return solver_.solve(r);
+      VecX x = solver_.solve(r);
+      if constexpr (requires { solver_.iterations(); }) {
+        ++counts.iterative_solves, counts.iterative_iterations += solver_.iterations();
+        fresh_iterations_ = solver_.iterations();
+      }
+      return x;
+    }
+    if constexpr (ReusableSetUp<S>) {
+      // the set-up at hand; a solve that needed more than twice the iterations of the last fresh
+      // one sets up afresh next time, one that failed at once
+      try {
+        VecX x = solver_.solve(J, r);
+        ++counts.reused, ++counts.iterative_solves, counts.iterative_iterations += solver_.iterations();
+        refactor_next_ = solver_.iterations() > 2 * fresh_iterations_;
+        return x;
+      } catch (const SolverError&) {
+        counts.iterative_iterations += solver_.iterations();
+      }
+      factorize(J);
+      ++counts.factorisations;
+      fresh_ = false;
+      VecX x = solver_.solve(r);
+      ++counts.iterative_solves, counts.iterative_iterations += solver_.iterations();
+      fresh_iterations_ = solver_.iterations();
+      return x;
     }
     VecX x;
     const GmresResult res = gmres(
@@ -133,6 +177,7 @@ class LinearSolve {
   bool factored_ = false;       // reuse on and factors at hand
   bool fresh_ = false;          // the factors are the matrix's of the coming solve
   bool refactor_next_ = false;  // the last reused solve needed many iterations
+  int fresh_iterations_ = 0;    // iterative: the iterations of the last solve after a set-up
   VecX analysed_values_, factored_values_;
   GmresWork work_;
 };

@@ -129,6 +129,9 @@ struct FlowOptions {
   /// solve likewise (physics/mesh_motion.hpp). The choice is automatic;
   /// false: every solve factorises (the results differ at the 1e-13 level). Checkpoints keep the
   /// factorised matrix, so a continued run is bit for bit the uninterrupted one either way.
+  /// An iterative solver with `ReusableSetUp` (SaddlePointGmres) sets up its preconditioner at
+  /// a step's first Newton iteration and keeps it for the step's others (afresh when a solve
+  /// needed more than twice the iterations of the set-up's first); false: at every iteration.
   bool reuse_factorisation = true;
   /// The start-up steps' formulas (time/stepper.hpp), taken while the history is shorter than
   /// the scheme reads (after the damped start, if any): MR/AB's (default, the paper's), or for

@@ -200,6 +200,9 @@ class Discretisation {
   /// Gives a block-aware solver the blocks for a velocity block holding gamma M_u (gamma =
   /// rho a_0 / (theta dt)); nothing for other solvers.
   void prepare_solver(Real gamma) {
+    // an iterative solver's preconditioner is set up once per step, at its first Newton
+    // iteration, and serves the others (LinearSolve, ReusableSetUp)
+    if constexpr (ReusableSetUp<Solver>) solve_.drop();
     if constexpr (TakesSaddlePointBlocks<Solver>) {
       if (gamma == gamma_) return;
       solve_.solver().set_blocks(saddle_point_blocks(*space_, *cons_, opt_.mu, gamma));

@@ -17,11 +17,13 @@
 // time tolerance is 1e-3 / 2^(level - 1) of the velocity scale.
 //
 // How to run: ./ten_cate [--case E4] [--level 1] [--t-end 1.5] [--output DIR] [--vtu-every 0]
-//             [--checkpoint-every 0] [--restart]    (`--help` lists the options)
+//             [--checkpoint-every 0] [--restart] [--no-reuse]    (`--help` lists the options)
 // What it prints: the mesh, a progress line every 10 steps, then u_max (the largest settling
 // speed) and when it was reached beside the measured value, the height of the sphere's bottom
-// and its speed at t_end, the remeshes (wall time, cells, worst quality before / after), the
-// steps, the wall and CPU times with their split and the peak memory. It writes DIR/bodies.csv
+// and its speed at t_end, when it came within the collision range of the floor and when it
+// stopped (speed below 1 % of u_max), the remeshes (wall time, cells, worst quality before / after), the
+// steps, the wall and CPU times with their split and the peak memory, the linear solves
+// (preconditioner set-ups, GMRES iterations per solve). It writes DIR/bodies.csv
 // (through alefsi::run: centre, quaternion, velocity, loads, gap per step), the flow's VTU
 // series (--vtu-every) and checkpoints (--checkpoint-every).
 #include <alefsi/alefsi.hpp>
@@ -64,9 +66,8 @@ struct Settings {
   std::string oil = "E4";
   int level = 1;
   Real t_end = 1.5, grading = 0.25, tolerance = 0;
-  int vtu_every = 0, checkpoint_every = 0;
-  bool restart = false;
-  std::filesystem::path output = "ten_cate_out";
+  bool no_reuse = false;
+  app::RunFiles files{.output = "ten_cate_out"};
 };
 
 bool parse(int argc, char** argv, Settings& o) {
@@ -76,10 +77,8 @@ bool parse(int argc, char** argv, Settings& o) {
       .add("grading", o.grading, "growth of the mesh size with the distance to the sphere")
       .add("tolerance", o.tolerance, "the time tolerance (0: the level's)")
       .add("t-end", o.t_end, "end time (s)")
-      .add("output", o.output, "folder for bodies.csv, VTU and checkpoints")
-      .add("vtu-every", o.vtu_every, "a VTU file every this many steps (0: none)")
-      .add("checkpoint-every", o.checkpoint_every, "a checkpoint every this many steps (0: only at the end)")
-      .flag("restart", o.restart, "continue from <output>/checkpoint.bin");
+      .flag("no-reuse", o.no_reuse, "set the preconditioner up at every Newton iteration (for comparison)");
+  o.files.add_to(opt);
   return opt.parse(argc, argv, std::cout);
 }
 
@@ -98,27 +97,30 @@ int main(int argc, char** argv) try {
   const Real h_body = D / (4 + 4 * o.level), h_far = std::min(8 * h_body, 0.01);
   const Real grading = o.grading;
   auto size = [=](const std::vector<Sphere>& s) { return graded_size(s, h_body, h_far, grading); };
-  const auto checkpoint = o.output / "checkpoint.bin";
+  const auto checkpoint = o.files.checkpoint();
   GmshMeshReport first;
-  Mesh<3> mesh = o.restart ? read_checkpoint_mesh<3>(checkpoint)
+  Mesh<3> mesh = o.files.restart ? read_checkpoint_mesh<3>(checkpoint)
                            : gmsh_box_mesh(box, {{start, a, sphere_tag}}, size({{start, a, sphere_tag}}), {}, &first);
-  Flow flow(std::move(mesh), {.rho = oil.rho, .mu = oil.mu});
+  Flow flow(std::move(mesh), {.rho = oil.rho, .mu = oil.mu, .reuse_factorisation = !o.no_reuse});
   for (int t : box.tags) flow.set_velocity(t, [](const alefsi::Vec<3>&, Real) { return alefsi::Vec<3>(0, 0, 0); });
   flow.add_body(sphere_body(sphere_tag, start, a, rho_p));
   // buoyancy from the sphere's exact volume: with rho_p / rho_f = 1.15-1.17 the polyhedral
   // hole's volume error would enter the net weight six times over (AleFlow::set_gravity)
   flow.set_gravity(alefsi::Vec<3>(0, 0, -g), Buoyancy::exact);
-  // the spring carries 4 buoyant weights at contact and acts within h_body / 2 of the floor
+  // eq. (24) on the normal approach speed, which resists separation too (the paper's |V| form
+  // pushes a rebounding sphere up: docs/results.md); the spring carries 4 buoyant weights at
+  // contact and acts within h_body / 2 of the floor
   const Real buoyant = (rho_p - oil.rho) * 4.0 / 3.0 * std::numbers::pi * a * a * a * g;
-  flow.set_collisions({.range = 0.1, .spring_range = 0.5 * h_body, .spring_force = 4 * buoyant});
+  flow.set_collisions(
+      {.range = 0.1, .spring_range = 0.5 * h_body, .spring_force = 4 * buoyant, .law = CollisionLaw::lubrication});
   auto remesher = std::make_unique<Remesher3D>(Remesh3DOptions{.box = box, .size = size, .mesher = {}});
   const Remesher3D& remeshes = *remesher;
   flow.set_remesher(std::move(remesher));
-  if (o.restart) flow.load_checkpoint(checkpoint);
+  if (o.files.restart) flow.load_checkpoint(checkpoint);
   std::cout << "ten_cate (" << Flow::Solver::name << ") " << o.oil << " (Re " << oil.re << "), level " << o.level << ": h_body = D / "
             << 4 + 4 * o.level << ", " << flow.mesh().n_cells() << " tetrahedra, "
             << flow.space().n_field() + Flow::body_dofs << " unknowns";
-  if (!o.restart) std::cout << " (gmsh " << std::setprecision(3) << first.seconds << " s)";
+  if (!o.files.restart) std::cout << " (gmsh " << std::setprecision(3) << first.seconds << " s)";
   std::cout << "; from t = " << flow.time() << " to " << o.t_end << " s\n";
 
   // the largest settling speed and when
@@ -127,9 +129,15 @@ int main(int argc, char** argv) try {
   run_opt.dt = 1e-3, run_opt.t_end = o.t_end;
   run_opt.tolerance = o.tolerance > 0 ? o.tolerance : 1e-3 / std::pow(2.0, o.level - 1);
   run_opt.velocity_scale = 0.1 * oil.u_measured;
-  run_opt.output = o.output, run_opt.vtu_every = o.vtu_every, run_opt.checkpoint_every = o.checkpoint_every;
+  o.files.apply(run_opt);
+  // the landing: the first step within the collision range (gap <= a / 10) and the first after
+  // it at which the sphere moves at less than 1 % of u_max
+  Real t_touch = -1, t_rest = -1;
   run_opt.on_step = [&] {
+    const Real speed = flow.body_velocity(0).head<3>().norm();
     if (-flow.body_velocity(0)[2] > u_max) u_max = -flow.body_velocity(0)[2], t_max = flow.time();
+    if (t_touch < 0 && flow.body_gaps()[0] <= 0.1 * a) t_touch = flow.time();
+    if (t_touch >= 0 && t_rest < 0 && speed < 0.01 * u_max) t_rest = flow.time();
   };
   const RunSummary sum = run(flow, run_opt);
 
@@ -139,16 +147,11 @@ int main(int argc, char** argv) try {
             << " %\n  at t = " << flow.time() << " s: bottom of the sphere " << 1e3 * (flow.body_centre(0)[2] - a)
             << " mm above the floor (gap " << 1e3 * flow.body_gaps()[0] << " mm), speed " << -flow.body_velocity(0)[2]
             << " m/s\n";
-  for (const auto& r : remeshes.reports())
-    std::cout << "  remesh: " << std::setprecision(3) << r.mesher.seconds << " s, " << r.mesher.cells
-              << " cells, worst quality " << r.before.worst << " -> " << r.mesher.quality.worst << "\n";
-  std::cout << "  " << sum.steps << " steps (" << sum.rejected << " rejected, dt " << sum.dt_smallest << " to "
-            << sum.dt_largest << " s), " << sum.remeshes << " remeshes, worst quality " << sum.worst_quality
-            << "; wall " << wall << " s, CPU " << app::cpu_seconds() - cpu0 << " s, peak " << std::setprecision(0)
-            << std::fixed << app::peak_mb() << " MB\n"
-            << std::setprecision(1) << "  phases: mesh velocity " << sum.t_mesh_velocity << " s, assembly "
-            << sum.t_assembly << " s, preconditioner set-up " << sum.t_factorize << " s, solves " << sum.t_solve
-            << " s, remeshing " << sum.t_remesh << " s\n";
+  if (t_touch >= 0) std::cout << "  within the collision range (gap <= a / 10) from t = " << t_touch << " s";
+  if (t_rest >= 0) std::cout << ", at rest (speed < 1 % of u_max) from t = " << t_rest << " s";
+  if (t_touch >= 0) std::cout << "\n";
+  app::print_remeshes(std::cout, remeshes.reports());
+  app::print_run(std::cout, sum, wall, app::cpu_seconds() - cpu0);
   return 0;
 } catch (const std::exception& e) {
   std::cerr << "ten_cate: " << e.what() << "\n";

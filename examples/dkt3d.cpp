@@ -73,26 +73,26 @@ int main(int argc, char** argv) try {
   const auto wall0 = std::chrono::steady_clock::now();
   const Real cpu0 = app::cpu_seconds();
 
-  const Real h_body = d / (8 * o.level), h_far = std::min(8 * h_body, 0.75);
-  const Real grading = o.grading;
-  auto size = [=](const std::vector<Sphere>& s) { return graded_size(s, h_body, h_far, grading); };
-  const std::vector<Sphere> spheres = {{lead_start, a, lead_tag}, {trail_start, a, trail_tag}};
+  const Real h_body = d / (8 * o.level);
+  const scenes::SpheresSettlingInBox scene{.box = box,
+                                           .spheres = {{lead_start, a, lead_tag}, {trail_start, a, trail_tag}},
+                                           .rho_f = rho_f,
+                                           .mu = nu * rho_f,
+                                           .rho_p = rho_p,
+                                           .g = g,
+                                           .h_body = h_body,
+                                           .h_far = std::min(8 * h_body, 0.75),
+                                           .grading = o.grading};
+  scene.validate();
   const auto checkpoint = o.files.checkpoint();
   GmshMeshReport first;
-  Mesh<3> mesh =
-      o.files.restart ? read_checkpoint_mesh<3>(checkpoint) : gmsh_box_mesh(box, spheres, size(spheres), {}, &first);
-  Flow flow(std::move(mesh), {.rho = rho_f, .mu = nu * rho_f});
-  for (int t : box.tags) flow.set_velocity(t, [](const alefsi::Vec<3>&, Real) { return alefsi::Vec<3>(0, 0, 0); });
-  flow.add_body(sphere_body(lead_tag, lead_start, a, rho_p));
-  flow.add_body(sphere_body(trail_tag, trail_start, a, rho_p));
-  flow.set_gravity(alefsi::Vec<3>(0, 0, -g), Buoyancy::exact);
-  // eq. (24) on the normal approach speed, which resists separation too (the paper's |V| form
-  // pushes a rebounding sphere up: docs/results.md); the spring carries 4 buoyant weights at
-  // contact and acts within h_body / 2
-  const Real buoyant = (rho_p - rho_f) * 4.0 / 3.0 * std::numbers::pi * a * a * a * g;
-  flow.set_collisions(
-      {.range = 0.1, .spring_range = 0.5 * h_body, .spring_force = 4 * buoyant, .law = CollisionLaw::lubrication});
-  auto remesher = std::make_unique<Remesher3D>(Remesh3DOptions{.box = box, .size = size, .mesher = {}});
+  Mesh<3> mesh = o.files.restart ? read_checkpoint_mesh<3>(checkpoint)
+                                 : gmsh_box_mesh(box, scene.spheres, scene.size_rule()(scene.spheres), {}, &first);
+  Flow flow(std::move(mesh), scene.flow_options());
+  // no-slip walls, the free spheres, gravity with exact buoyancy, contact by eq. (24) on the
+  // approach speed and a spring of range h_body / 2 carrying 4 buoyant weights
+  scene.configure(flow);
+  auto remesher = std::make_unique<Remesher3D>(Remesh3DOptions{.box = box, .size = scene.size_rule(), .mesher = {}});
   const Remesher3D& remeshes = *remesher;
   flow.set_remesher(std::move(remesher));
   if (o.files.restart) flow.load_checkpoint(checkpoint);

@@ -36,7 +36,6 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
-#include <numbers>
 #include <string>
 
 using namespace alefsi;
@@ -94,26 +93,30 @@ int main(int argc, char** argv) try {
   const auto wall0 = std::chrono::steady_clock::now();
   const Real cpu0 = app::cpu_seconds();
 
-  const Real h_body = D / (4 + 4 * o.level), h_far = std::min(8 * h_body, 0.01);
-  const Real grading = o.grading;
-  auto size = [=](const std::vector<Sphere>& s) { return graded_size(s, h_body, h_far, grading); };
+  const Real h_body = D / (4 + 4 * o.level);
+  const scenes::SpheresSettlingInBox scene{.box = box,
+                                           .spheres = {{start, a, sphere_tag}},
+                                           .rho_f = oil.rho,
+                                           .mu = oil.mu,
+                                           .rho_p = rho_p,
+                                           .g = g,
+                                           .h_body = h_body,
+                                           .h_far = std::min(8 * h_body, 0.01),
+                                           .grading = o.grading};
+  scene.validate();
   const auto checkpoint = o.files.checkpoint();
   GmshMeshReport first;
   Mesh<3> mesh = o.files.restart ? read_checkpoint_mesh<3>(checkpoint)
-                           : gmsh_box_mesh(box, {{start, a, sphere_tag}}, size({{start, a, sphere_tag}}), {}, &first);
-  Flow flow(std::move(mesh), {.rho = oil.rho, .mu = oil.mu, .reuse_factorisation = !o.no_reuse});
-  for (int t : box.tags) flow.set_velocity(t, [](const alefsi::Vec<3>&, Real) { return alefsi::Vec<3>(0, 0, 0); });
-  flow.add_body(sphere_body(sphere_tag, start, a, rho_p));
-  // buoyancy from the sphere's exact volume: with rho_p / rho_f = 1.15-1.17 the polyhedral
-  // hole's volume error would enter the net weight six times over (AleFlow::set_gravity)
-  flow.set_gravity(alefsi::Vec<3>(0, 0, -g), Buoyancy::exact);
-  // eq. (24) on the normal approach speed, which resists separation too (the paper's |V| form
-  // pushes a rebounding sphere up: docs/results.md); the spring carries 4 buoyant weights at
-  // contact and acts within h_body / 2 of the floor
-  const Real buoyant = (rho_p - oil.rho) * 4.0 / 3.0 * std::numbers::pi * a * a * a * g;
-  flow.set_collisions(
-      {.range = 0.1, .spring_range = 0.5 * h_body, .spring_force = 4 * buoyant, .law = CollisionLaw::lubrication});
-  auto remesher = std::make_unique<Remesher3D>(Remesh3DOptions{.box = box, .size = size, .mesher = {}});
+                                 : gmsh_box_mesh(box, scene.spheres, scene.size_rule()(scene.spheres), {}, &first);
+  FlowOptions flow_opt = scene.flow_options();
+  flow_opt.reuse_factorisation = !o.no_reuse;
+  Flow flow(std::move(mesh), flow_opt);
+  // no-slip walls, the free sphere, gravity with the sphere's exact buoyancy (with
+  // rho_p / rho_f = 1.15-1.17 the polyhedral hole's volume error would enter the net weight six
+  // times over), contact by eq. (24) on the approach speed (the paper's |V| form makes the sphere
+  // rebound: docs/results.md) and a spring of range h_body / 2 carrying 4 buoyant weights
+  scene.configure(flow);
+  auto remesher = std::make_unique<Remesher3D>(Remesh3DOptions{.box = box, .size = scene.size_rule(), .mesher = {}});
   const Remesher3D& remeshes = *remesher;
   flow.set_remesher(std::move(remesher));
   if (o.files.restart) flow.load_checkpoint(checkpoint);

@@ -11,6 +11,7 @@
 
 #include "alefsi/mesh/io/gmsh.hpp"
 #include "alefsi/scenes/settling_sphere.hpp"
+#include "alefsi/scenes/spheres_settling_in_box.hpp"
 #include "alefsi/sim/ale_flow.hpp"
 
 using namespace alefsi;
@@ -491,6 +492,43 @@ TEST_CASE("3D contact in a flow: a sphere lands on the floor of its box and rest
   CHECK(flow.body_gaps()[0] == Approx(rest).epsilon(1e-4));
   CHECK(flow.body_collision_force(0)[2] == Approx(carried).epsilon(1e-4));
   CHECK(flow.body_collision_force(0).head<2>().norm() < 1e-9 * carried);  // the floor pushes straight up
+}
+
+TEST_CASE("scenes::SpheresSettlingInBox: bad parameters are refused by name; its contact model",
+          "[bodies3d][scenes][quick]") {
+  using scenes::SpheresSettlingInBox;
+  const SpheresSettlingInBox s{.box = {.lo = Vec<3>(-1, -1, 0), .hi = Vec<3>(1, 1, 3)},
+                               .spheres = {{Vec<3>(0, 0, 2), 0.25, 7}, {Vec<3>(0.5, 0, 1), 0.2, 8}},
+                               .rho_f = 1,
+                               .mu = 0.1,
+                               .rho_p = 1.5,
+                               .g = 10,
+                               .h_body = 0.1,
+                               .h_far = 0.5};
+  CHECK_NOTHROW(s.validate());
+  auto refused = [](const SpheresSettlingInBox& x, const std::string& name) {
+    CAPTURE(name);
+    CHECK_THROWS_WITH(x.validate(), Catch::Contains(name));
+    CHECK_THROWS_AS(x.validate(), InvalidArgument);
+  };
+  auto t = s;
+  t.rho_p = 1, refused(t, "rho_p");  // would not settle
+  t = s, t.mu = 0, refused(t, "mu");
+  t = s, t.g = -1, refused(t, "'g'");
+  t = s, t.h_far = 0.05, refused(t, "h_far");
+  t = s, t.spring_weights = 1, refused(t, "spring_weights");
+  t = s, t.spheres.clear(), refused(t, "spheres");
+  t = s, t.spheres[1].centre = Vec<3>(0, 0, 2.3), refused(t, "bodies[");  // overlapping the first
+  t = s, t.spheres[0].centre = Vec<3>(0, 0, 2.9), refused(t, "bodies[0]");  // through the lid
+  // eq. (24) on the approach speed, the spring of range h_body / 2 carrying 4 buoyant weights of
+  // the smaller sphere
+  const CollisionOptions c = s.collisions();
+  CHECK(c.law == CollisionLaw::lubrication);
+  CHECK(c.range == 0.1);
+  CHECK(c.spring_range == Approx(0.05).epsilon(1e-15));
+  CHECK(c.spring_force == Approx(4 * 0.5 * 4.0 / 3.0 * std::numbers::pi * 0.008 * 10).epsilon(1e-14));
+  CHECK(s.size_rule()(s.spheres)(Vec<3>(0, 0, 2.25)) == Approx(0.1).epsilon(1e-15));  // h_body on a sphere
+  CHECK(s.size_rule()(s.spheres)(Vec<3>(-1, -1, 0)) == Approx(0.5).epsilon(1e-15));   // h_far far away
 }
 
 TEST_CASE("scenes::SettlingSphere: bad parameters are refused by name; the wall factor of concentric spheres",

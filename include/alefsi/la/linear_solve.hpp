@@ -14,6 +14,7 @@
 ///     if (!lin.reusable()) lin.factorize(J);
 ///     VecX x = lin.solve(J, r, counts);
 #include <concepts>
+#include <optional>
 #include <utility>
 
 #include "alefsi/core/eigen_sparse.hpp"
@@ -101,50 +102,17 @@ class LinearSolve {
   /// Solves J x = r: directly after factorize(J); otherwise by GMRES preconditioned by the
   /// factors at hand, and, when that misses its tolerance in max_iterations, by factorising J.
   VecX solve(const SparseMatrix& J, const VecX& r, LinearSolveCounts& counts) {
-    if (fresh_ || !reusable()) {
-      if (!fresh_) factorize(J), ++counts.factorisations;
-      fresh_ = false;
-      VecX x = solver_.solve(r);
-      if constexpr (requires { solver_.iterations(); }) {
-        ++counts.iterative_solves, counts.iterative_iterations += solver_.iterations();
-        fresh_iterations_ = solver_.iterations();
-      }
-      return x;
-    }
-    if constexpr (ReusableSetUp<S>) {
-      // the set-up at hand; a solve that needed more than twice the iterations of the last fresh
-      // one sets up afresh next time, one that failed at once
-      try {
-        VecX x = solver_.solve(J, r);
-        ++counts.reused, ++counts.iterative_solves, counts.iterative_iterations += solver_.iterations();
-        refactor_next_ = solver_.iterations() > 2 * fresh_iterations_;
-        return x;
-      } catch (const SolverError&) {
-        counts.iterative_iterations += solver_.iterations();
-      }
-      factorize(J);
-      ++counts.factorisations;
-      fresh_ = false;
-      VecX x = solver_.solve(r);
+    if (!fresh_ && reusable())
+      if (std::optional<VecX> x = solve_on_kept(J, r, counts)) return std::move(*x);
+    // the factors (set-up) of J: the fresh ones, or made now
+    if (!fresh_) factorize(J), ++counts.factorisations;
+    fresh_ = false;
+    VecX x = solver_.solve(r);
+    if constexpr (requires { solver_.iterations(); }) {
       ++counts.iterative_solves, counts.iterative_iterations += solver_.iterations();
       fresh_iterations_ = solver_.iterations();
-      return x;
     }
-    VecX x;
-    const GmresResult res = gmres(
-        J, r, [this](const VecX& v) { return VecX(solver_.solve(v)); },
-        {.tolerance = reuse_.tolerance, .max_iterations = reuse_.max_iterations, .restart = reuse_.max_iterations}, x,
-        work_);
-    counts.krylov_iterations += res.iterations;
-    if (res.converged) {
-      ++counts.reused;
-      refactor_next_ = res.iterations > reuse_.refactor_above;
-      return x;
-    }
-    factorize(J);
-    ++counts.factorisations;
-    fresh_ = false;
-    return solver_.solve(r);
+    return x;
   }
   /// The values of the matrices analysed and factorised last (empty: none, or reuse off), and
   /// whether the next solve factorises: what a checkpoint keeps.
@@ -169,6 +137,34 @@ class LinearSolve {
   const S& solver() const { return solver_; }
 
  private:
+  // J x = r on the factors (set-up) of an earlier matrix; none when that misses its tolerance
+  // (the caller then factorises J). A solve that needed many iterations makes the next one
+  // factorise: direct, more than refactor_above GMRES iterations; iterative, more than twice
+  // the iterations of the set-up's first solve.
+  std::optional<VecX> solve_on_kept(const SparseMatrix& J, const VecX& r, LinearSolveCounts& counts) {
+    if constexpr (ReusableSetUp<S>) {
+      try {
+        VecX x = solver_.solve(J, r);
+        ++counts.reused, ++counts.iterative_solves, counts.iterative_iterations += solver_.iterations();
+        refactor_next_ = solver_.iterations() > 2 * fresh_iterations_;
+        return x;
+      } catch (const SolverError&) {
+        counts.iterative_iterations += solver_.iterations();
+        return std::nullopt;
+      }
+    } else {
+      VecX x;
+      const GmresResult res = gmres(
+          J, r, [this](const VecX& v) { return VecX(solver_.solve(v)); },
+          {.tolerance = reuse_.tolerance, .max_iterations = reuse_.max_iterations, .restart = reuse_.max_iterations},
+          x, work_);
+      counts.krylov_iterations += res.iterations;
+      if (!res.converged) return std::nullopt;
+      ++counts.reused;
+      refactor_next_ = res.iterations > reuse_.refactor_above;
+      return x;
+    }
+  }
   static VecX values(const SparseMatrix& J) { return Eigen::Map<const VecX>(J.valuePtr(), J.nonZeros()); }
 
   S solver_;

@@ -183,7 +183,7 @@ TEST_CASE("body rows: the body blocks of add_rows match finite differences (2D w
     contact.set_walls(mesh, bodies.tags());
     const auto placed = bodies.contact_bodies(states, -1);
     REQUIRE(contact.find(placed, 0.01) == 1);
-    const auto& k = contact.contacts()[0];
+    const Contact<2> k = contact.contacts()[0];  // a copy: find() below replaces the list
     CHECK(k.gap > 0.01);  // 0.0268 less the step's approach (about 0.009)
     CHECK(k.gap < 0.0268);
     CHECK(std::abs(k.normal[0]) > 0.99);     // across A's right edge
@@ -200,6 +200,33 @@ TEST_CASE("body rows: the body blocks of add_rows match finite differences (2D w
     CHECK(std::abs(k.arm_k[1] - 0.173) < 0.01);
     CHECK(states[0].contact[2] == Approx(k.arm_k[0] * F[1] - k.arm_k[1] * F[0]).epsilon(1e-14));
     CHECK(states[0].contact[2] > 0);
+
+    // The same squares given their exact shapes (convex polygons in the body frame; the second
+    // body's angle is its 30 degrees, so its shape is the unturned square): GJK on the shapes,
+    // moved by the step's rigid motion, finds the facet model's contact (exact for polygons).
+    BodySystem<2, RigidBodyTraits<2>> shaped;
+    std::vector<BodyState<2, RigidBodyTraits<2>>> shaped_states;
+    for (std::size_t i = 0; i < squares.size(); ++i) {
+      RigidBody2D body = free_body(squares[i].tag, mass_properties(squares[i], 1.5));
+      body.angle = i == 0 ? 0 : std::numbers::pi / 6;
+      body.shape = convex::support_of<2>(convex::Polytope<2>{{Vec<2>(-0.2, -0.2), Vec<2>(0.2, -0.2), Vec<2>(0.2, 0.2), Vec<2>(-0.2, 0.2)}});
+      shaped.add(body, mesh, 0.0, shaped_states);
+    }
+    shaped_states[0].velocity.fill(Vec<3>(0.4, 0.1, 0.3));
+    shaped_states[1].velocity.fill(Vec<3>(-0.5, 0.2, -0.1));
+    shaped.attach(mesh);
+    NodeVelocities<2> shaped_nodes;
+    shaped.mesh_velocity_data(shaped_states, mesh.coordinates(), c.extrapolation, 0.01, shaped_nodes);
+    std::vector<Vec<2>> y = mesh.coordinates();
+    shaped.advance(shaped_states, c, y);
+    const auto with_shapes = shaped.contact_bodies(shaped_states, -1);
+    CHECK(with_shapes[1].surface.empty());  // the shape replaces the facets
+    REQUIRE(contact.find(with_shapes, 0.01) == 1);
+    const auto& s = contact.contacts()[0];
+    CHECK(s.gap == Approx(k.gap).epsilon(1e-10));
+    CHECK((s.normal - k.normal).norm() < 1e-10);
+    CHECK((s.arm_k - k.arm_k).norm() < 1e-10);
+    CHECK((s.arm_j - k.arm_j).norm() < 1e-10);
   }
   SECTION("3D: a free anisotropic body turning off its principal axes") {
     const Mesh<3> mesh = read_gmsh<3>(std::string(ALEFSI_TEST_DATA_DIR) + "/gmsh/sphere_in_box3d.msh").mesh;

@@ -40,7 +40,10 @@
 /// sphere (radius > 0) is exact: d = |X^K - X^J| - r^K - r^J between two of them, the distance
 /// from its centre to the nearest facet minus r against facets. Otherwise d is the smallest
 /// facet-to-facet distance (exact, 0 for facets that cross), with facet pairs culled by their
-/// bounding balls.
+/// bounding balls. A body with a convex shape (`CollisionBody::convex`: an ellipse, a capsule,
+/// a polygon ...) is measured on that shape by GJK against another shape, a disk/sphere or a
+/// wall facet, so its distances and nearest points are those of the exact curve, not of the
+/// mesh's facets; n is then the normal at the nearest points (from J's towards K's).
 ///
 /// Search: only pairs whose bounding balls (centre, farthest surface point + reach) overlap
 /// are examined, found through a uniform grid of cell size = the largest bounding diameter:
@@ -64,6 +67,7 @@
 #include "alefsi/core/error.hpp"
 #include "alefsi/core/grid.hpp"
 #include "alefsi/core/types.hpp"
+#include "alefsi/physics/convex.hpp"
 
 namespace alefsi {
 
@@ -110,7 +114,10 @@ struct CollisionBody {
   Real radius = 0;                   ///< > 0: a disk / sphere of this radius (exact distances)
   Real r_in = 0;                     ///< Rbar: smallest distance from the centre to the surface
   Real r_out = 0;                    ///< largest distance from the centre to the surface
-  std::vector<Facet<D>> surface;     ///< used when radius == 0
+  std::vector<Facet<D>> surface;     ///< used when radius == 0 and there is no `convex` shape
+  /// The exact convex shape in world coordinates (physics/convex.hpp), if known: distances to
+  /// other shapes, disks/spheres and wall facets by GJK, nearest points exact.
+  alefsi::convex::Support<D> convex;
 };
 using CollisionBody2D = CollisionBody<2>;
 
@@ -307,6 +314,19 @@ Nearest<D> nearest_ball_facets(const Vec<D>& c, Real r, const std::vector<Facet<
   return out;
 }
 
+/// A wall facet as a GJK shape (the hull of its D vertices).
+template <int D>
+struct FacetShape {
+  const Facet<D>* facet;
+  Vec<D> support(const Vec<D>& d) const {
+    int best = 0;
+    for (int i = 1; i < D; ++i)
+      if ((*facet)[i].dot(d) > (*facet)[best].dot(d)) best = i;
+    return (*facet)[best];
+  }
+  Real margin() const { return 0; }
+};
+
 template <int D>
 using CellKey = std::array<std::int64_t, D>;
 template <int D>
@@ -431,6 +451,13 @@ class ContactGeometry {
       if (gap <= delta) out.push_back({k, j, gap, rbar, dc / dist});
       return;
     }
+    if ((A.convex || A.radius > 0) && (B.convex || B.radius > 0)) {
+      const auto g = convex::distance<D>(shape(A), shape(B));
+      if (g.distance > delta) return;
+      const Vec<D> x = (g.a + g.b) / 2;
+      out.push_back({k, j, g.distance, rbar, direction(g.normal, dc / dist, 1), x - A.centre, x - B.centre});
+      return;
+    }
     detail::Nearest<D> n;  // a on K, b on J
     if (A.radius > 0) {
       n = detail::nearest_ball_facets<D>(A.centre, A.radius, B.surface);
@@ -450,6 +477,12 @@ class ContactGeometry {
   static Vec<D> direction(const Vec<D>& v, const Vec<D>& fallback, Real scale) {
     const Real n = v.norm();
     return n > 1e-12 * scale ? Vec<D>(v / n) : fallback;
+  }
+
+  /// A disk/sphere or a convex shape as a GJK shape.
+  static convex::Support<D> shape(const CollisionBody<D>& b) {
+    if (b.convex) return b.convex;
+    return {[c = b.centre](const Vec<D>&) { return c; }, b.radius};
   }
 
   void wall(const CollisionBody<D>& b, int k, Real delta, std::vector<Proximity<D>>& out) const {
@@ -472,6 +505,21 @@ class ContactGeometry {
     }
     Real best = std::numeric_limits<Real>::infinity();
     Vec<D> best_point = b.centre, body_point = b.centre;
+    if (b.convex) {
+      // the facets in order of a lower bound on their distance (centre's minus r_out)
+      const convex::Support<D> s = shape(b);
+      Vec<D> normal = Vec<D>::Zero();
+      for (const auto& [bound, w] : facet_order(b, cand)) {
+        if (bound >= best) break;
+        const auto g = convex::distance<D>(s, detail::FacetShape<D>{&walls_[w]});
+        if (g.distance < best) best = g.distance, best_point = g.b, body_point = g.a, normal = g.normal;
+      }
+      if (best > delta) return;
+      const Vec<D> c = b.centre - best_point;
+      const Vec<D> x = (body_point + best_point) / 2;
+      out.push_back({k, -1, best, b.r_in, direction(normal, c.norm() > 0 ? Vec<D>(c.normalized()) : normal, 1), x - b.centre});
+      return;
+    }
     if (b.radius > 0) {
       for (Index w : cand) {
         const Vec<D> p = detail::closest_on_facet(b.centre, walls_[w]);
@@ -479,12 +527,7 @@ class ContactGeometry {
         if (gap < best) best = gap, best_point = p;
       }
     } else {
-      // the facets in order of a lower bound on their distance (centre's minus r_out)
-      std::vector<std::pair<Real, Index>> order;
-      order.reserve(cand.size());
-      for (Index w : cand) order.push_back({(b.centre - detail::closest_on_facet(b.centre, walls_[w])).norm() - b.r_out, w});
-      std::sort(order.begin(), order.end());
-      for (const auto& [bound, w] : order) {
+      for (const auto& [bound, w] : facet_order(b, cand)) {
         if (bound >= best) break;
         const auto n = detail::nearest_facets<D>(b.surface, {walls_[w]});
         if (n.distance < best) best = n.distance, best_point = n.b, body_point = n.a;
@@ -500,6 +543,16 @@ class ContactGeometry {
       const Vec<D> x = (body_point + best_point) / 2;
       out.push_back({k, -1, best, b.r_in, direction(body_point - best_point, n / nn, b.r_in), x - b.centre});
     }
+  }
+
+  /// The candidate wall facets in order of a lower bound on their distance to body b (its
+  /// centre's minus r_out).
+  std::vector<std::pair<Real, Index>> facet_order(const CollisionBody<D>& b, const std::vector<Index>& cand) const {
+    std::vector<std::pair<Real, Index>> order;
+    order.reserve(cand.size());
+    for (Index w : cand) order.push_back({(b.centre - detail::closest_on_facet(b.centre, walls_[w])).norm() - b.r_out, w});
+    std::sort(order.begin(), order.end());
+    return order;
   }
 
   std::vector<Facet<D>> walls_;

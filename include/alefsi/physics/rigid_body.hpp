@@ -39,6 +39,7 @@
 #include "alefsi/core/error.hpp"
 #include "alefsi/core/types.hpp"
 #include "alefsi/mesh/mesh.hpp"
+#include "alefsi/physics/convex.hpp"
 
 namespace alefsi {
 
@@ -59,6 +60,11 @@ struct RigidBody2D {
   /// > 0: the body is a disk of this radius. Its surface is then kept on the exact circle
   /// when the mesh is adapted, and collision distances are exact.
   Real radius = 0;
+  /// The exact convex shape (physics/convex.hpp) in the body frame: centred at the centre of
+  /// mass, its axes turned by `angle` at t0 (so an ellipse with semi-axes (a, b) and this
+  /// `angle` is the mesher's Ellipse{centre, a, b, angle}). Set: collision distances and contact
+  /// points are the shape's (GJK), not the mesh surface's facets. Empty: the facets'.
+  convex::Support<2> shape;
 
   bool free() const { return !prescribed; }
 
@@ -189,6 +195,10 @@ struct RigidBody3D {
   std::function<Vec<3>(const Vec<3>& r)> slip;
   /// > 0: the body is a sphere of this radius (informative; surface nodes are checked against it).
   Real radius = 0;
+  /// The exact convex shape (physics/convex.hpp) in the body frame (the frame `orientation`
+  /// turns to the world), centred at the centre of mass. Set: collision distances and contact
+  /// points are the shape's (GJK), not the mesh surface's facets. Empty: the facets'.
+  convex::Support<3> shape;
 
   bool free() const { return !prescribed; }
 
@@ -374,6 +384,13 @@ struct RigidBodyTraits<2> : RigidBodyAccessors<RigidBody2D, Vec<3>> {
   /// A surface offset at t0 as stored (world axes at the initial angle).
   static Vec<2> initial_offset(const Vec<2>& r, const Body&) { return r; }
   static Vec<2> to_world(const Vec<2>& r0, Orientation th, const Body& b) { return rotate(r0, th - b.angle); }
+  /// The body's convex shape (if any) in the axes of its surface offsets: turned by `angle`.
+  static convex::Support<2> shape(const Body& b) {
+    if (!b.shape) return {};
+    Mat<2> Q;
+    Q.col(0) = rotate(Vec<2>::UnitX(), b.angle), Q.col(1) = rotate(Vec<2>::UnitY(), b.angle);
+    return convex::placed<2>(b.shape, Vec<2>::Zero(), Q);
+  }
   static Vec<2> to_body(const Vec<2>& r, Orientation th, const Body& b) { return rotate(r, -(th - b.angle)); }
   static std::array<Velocity, 2> rows(const Vec<2>& r) { return rigid_rows(r); }
   static Vec<2> velocity(const Velocity& Z, const Vec<2>& r) { return rigid_velocity(Z, r); }
@@ -417,6 +434,8 @@ struct RigidBodyTraits<3> : RigidBodyAccessors<RigidBody3D, Vec<6>> {
   /// A surface offset at t0, stored in the body frame.
   static Vec<3> initial_offset(const Vec<3>& r, const Body& b) { return b.orientation.conjugate() * r; }
   static Vec<3> to_world(const Vec<3>& rb, const Orientation& q, const Body&) { return q * rb; }
+  /// The body's convex shape (if any) in the axes of its surface offsets: the body frame.
+  static convex::Support<3> shape(const Body& b) { return b.shape; }
   static Vec<3> to_body(const Vec<3>& r, const Orientation& q, const Body&) { return q.conjugate() * r; }
   static std::array<Velocity, 3> rows(const Vec<3>& r) { return rigid_rows(r); }
   static Vec<3> velocity(const Velocity& Z, const Vec<3>& r) { return rigid_velocity(Z, r); }

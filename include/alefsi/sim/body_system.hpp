@@ -448,13 +448,20 @@ class BodySystem {
         const auto it = std::lower_bound(e.nodes.begin(), e.nodes.end(), v);
         return Vec<D>(c.centre + M::to_world(s.surface[std::size_t(it - e.nodes.begin())], th, e.data));
       };
+      if constexpr (requires { M::shape(e.data); }) {
+        if (const auto shape = M::shape(e.data); shape && c.radius == 0) {  // in the offsets' axes
+          Mat<D> Q;
+          for (int i = 0; i < D; ++i) Q.col(i) = M::to_world(Vec<D>::Unit(i), th, e.data);
+          c.convex = convex::placed<D>(shape, c.centre, Q);
+        }
+      }
       c.r_in = std::numeric_limits<Real>::infinity();
       for (const auto& r0 : s.surface) c.r_out = std::max(c.r_out, r0.norm());
       for (const auto& f : e.facets) {
         std::array<Vec<D>, D> x;
         for (int i = 0; i < D; ++i) x[i] = at(f[i]);
         c.r_in = std::min(c.r_in, (detail::closest_on_facet(c.centre, x) - c.centre).norm());
-        if (c.radius == 0) c.surface.push_back(x);
+        if (c.radius == 0 && !c.convex) c.surface.push_back(x);
       }
       if (c.radius > 0) c.r_in = c.r_out = c.radius;
       out.push_back(std::move(c));

@@ -91,7 +91,7 @@ class CollisionContact final : public ContactModel<D> {
     std::vector<CollisionBody<D>> out(bodies.size());
     for (std::size_t k = 0; k < bodies.size(); ++k) {
       const auto& b = bodies[k];
-      out[k] = {b.centre, b.velocity, b.radius, b.r_in, b.r_out, b.surface};
+      out[k] = {b.centre, b.velocity, b.radius, b.r_in, b.r_out, b.surface, b.convex};
     }
     return out;
   }

@@ -32,6 +32,7 @@
 
 #include "alefsi/core/types.hpp"
 #include "alefsi/mesh/mesh.hpp"
+#include "alefsi/physics/convex.hpp"
 
 namespace alefsi {
 
@@ -44,8 +45,10 @@ struct ContactBody {
   Real r_in = 0;                     ///< smallest distance from the centre to the surface
   Real r_out = 0;                    ///< largest distance from the centre to the surface
   /// The surface facets in world coordinates (2D: segments, 3D: triangles); filled only when
-  /// radius == 0.
+  /// radius == 0 and there is no `convex` shape.
   std::vector<std::array<Vec<D>, D>> surface;
+  /// The body's exact convex shape in world coordinates, if it has one (physics/convex.hpp).
+  alefsi::convex::Support<D> convex;
 };
 
 /// Two bodies whose surfaces overlap (gap <= 0).

@@ -248,6 +248,21 @@ TEST_CASE("body rows: the body blocks of add_rows match finite differences (2D w
     bodies.advance(states, c, x);
     NoContact<3> none;
     check_body_jacobian<3>(space, bodies, states, none, c, Vec<3>(0, 0, -1));
+
+    // A shape is given in the body frame, which the orientation turns to the world: the contact
+    // body's support is x_g + R(q) s(R(q)^T d) (checked at t^n, where q is the initial one).
+    BodySystem<3, RigidBodyTraits<3>> shaped;
+    std::vector<BodyState<3, RigidBodyTraits<3>>> shaped_states;
+    RigidBody3D ellipsoid = body;
+    ellipsoid.radius = 0;
+    const convex::Ellipsoid<3> e{{0.2, 0.1, 0.15}};
+    ellipsoid.shape = convex::support_of<3>(e);
+    shaped.add(ellipsoid, mesh, 0.0, shaped_states);
+    const auto placed = shaped.contact_bodies(shaped_states, 0);
+    REQUIRE(placed[0].convex);
+    const Mat<3> R = body.orientation.toRotationMatrix();
+    for (const Vec<3>& d : {Vec<3>(1, 0, 0), Vec<3>(0.3, -0.8, 0.5), Vec<3>(-0.2, 0.1, -1)})
+      CHECK((placed[0].convex.support(d) - (body.centre + R * e.support(Vec<3>(R.transpose() * d)))).norm() < 1e-14);
   }
 }
 

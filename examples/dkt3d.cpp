@@ -10,7 +10,8 @@
 // the leading sphere's centre at (0, 0, 20), the trailing one's at (0.05, 0, 21.5): the small
 // sideways offset seeds the tumble. Units: d, and time in d / (g d)^{1/2}.
 //
-// Levels: the mesh size at the spheres is h_body = d / (8 level) (level 1: d / 8, 2: d / 16),
+// Levels: the mesh size at the spheres is h_body = d / (8 level) (level 1: d / 8, 2: d / 16;
+// fractional levels in [0.5, 4] too, e.g. 0.75: d / 6, 1.5: d / 12),
 // growing by `grading` with the distance to h_far = min(8 h_body, 0.75); the time tolerance is
 // 1e-3 / 2^(level - 1) of the velocity scale (0.1 of the buoyant velocity scale).
 //
@@ -49,7 +50,7 @@ const BoxDomain box{.lo = Vec<3>(-3, -3, 0), .hi = Vec<3>(3, 3, 24)};
 const Vec<3> lead_start(0, 0, 20), trail_start(0.05, 0, 21.5);
 
 struct Settings {
-  int level = 1;
+  Real level = 1;
   Real t_end = 40, grading = 0.25, tolerance = 0;
   app::RunFiles files{.output = "dkt3d_out"};
 };
@@ -69,7 +70,7 @@ bool parse(int argc, char** argv, Settings& o) {
 int main(int argc, char** argv) try {
   Settings o;
   if (!parse(argc, argv, o)) return 0;
-  ALEFSI_CHECK_ARG(o.level >= 1 && o.level <= 4, "level", "must be in 1..4, got ", o.level);
+  ALEFSI_CHECK_ARG(o.level >= 0.5 && o.level <= 4, "level", "must be in [0.5, 4], got ", o.level);
   const auto wall0 = std::chrono::steady_clock::now();
   const Real cpu0 = app::cpu_seconds();
 

@@ -268,6 +268,28 @@ TEST_CASE("Collision model on convex shapes: exact gaps, normals and contact poi
       CHECK(std::abs(shaped[i].arm_k[0] * Fs[1] - shaped[i].arm_k[1] * Fs[0]) <= 1e-12 * Fs.norm());  // through the centre
     }
   }
+  SECTION("a shape against a body known only by its facets (a square): the polygon's GJK distance") {
+    const std::vector<Vec<2>> sq = {Vec<2>(0.5, 0.3), Vec<2>(0.8, 0.3), Vec<2>(0.8, 0.6), Vec<2>(0.5, 0.6)};
+    CollisionBody<2> square;
+    square.centre = Vec<2>(0.65, 0.45), square.r_in = 0.15, square.r_out = 0.15 * std::sqrt(2.0);
+    square.surface = polygon_facets(sq);
+    const auto ell = ellipse_body(Vec<2>(0.2, 0.5), 0.2, Vec<2>(1, 0));
+    const auto g = convex::distance<2>(ell.convex, convex::Polytope<2>{sq});
+    REQUIRE(g.distance > 0);
+    REQUIRE(g.distance < 0.05);
+    for (const bool shape_first : {true, false}) {
+      const std::vector<CollisionBody<2>> bodies = shape_first ? std::vector{ell, square} : std::vector{square, ell};
+      const auto contacts = model.contacts(bodies, 1.0);
+      const auto it = std::find_if(contacts.begin(), contacts.end(), [](const auto& c) { return c.j >= 0; });
+      REQUIRE(it != contacts.end());
+      CHECK(it->gap == Approx(g.distance).epsilon(1e-12));
+      const Vec<2> towards_k = shape_first ? g.normal : Vec<2>(-g.normal);  // g.normal: from the square to the ellipse
+      CHECK((it->normal - towards_k).norm() < 1e-12);
+      // the point along a flat edge is fixed only to the square root of the distance's accuracy
+      CHECK((bodies[0].centre + it->arm_k - (g.a + g.b) / 2).norm() < 1e-6);
+      CHECK(CollisionModel<2>::force(*it, bodies).dot(towards_k) > 0);  // the ellipse moves towards the square
+    }
+  }
   SECTION("two ellipses: the normal is the curves' common normal, forces opposite, torques about each centre") {
     const auto A = ellipse_body(Vec<2>(0, 0.6), 0.4, Vec<2>(0.5, 0));
     const auto B = ellipse_body(Vec<2>(0.6, 0.68), -0.3, Vec<2>(-0.5, 0));

@@ -458,6 +458,18 @@ class ContactGeometry {
       out.push_back({k, j, g.distance, rbar, direction(g.normal, dc / dist, 1), x - A.centre, x - B.centre});
       return;
     }
+    if (A.convex || B.convex) {  // a shape against a body known by its facets
+      const bool k_shaped = bool(A.convex);
+      const CollisionBody<D>& S = k_shaped ? A : B;
+      std::vector<const Facet<D>*> facets;
+      for (const auto& f : (k_shaped ? B : A).surface) facets.push_back(&f);
+      const auto g = nearest_to_facets(S, facets);
+      if (g.distance > delta) return;
+      const Vec<D> x = (g.a + g.b) / 2;
+      const Vec<D> normal = k_shaped ? g.normal : Vec<D>(-g.normal);  // from J towards K
+      out.push_back({k, j, g.distance, rbar, direction(normal, dc / dist, 1), x - A.centre, x - B.centre});
+      return;
+    }
     detail::Nearest<D> n;  // a on K, b on J
     if (A.radius > 0) {
       n = detail::nearest_ball_facets<D>(A.centre, A.radius, B.surface);
@@ -506,18 +518,14 @@ class ContactGeometry {
     Real best = std::numeric_limits<Real>::infinity();
     Vec<D> best_point = b.centre, body_point = b.centre;
     if (b.convex) {
-      // the facets in order of a lower bound on their distance (centre's minus r_out)
-      const convex::Support<D> s = shape(b);
-      Vec<D> normal = Vec<D>::Zero();
-      for (const auto& [bound, w] : facet_order(b, cand)) {
-        if (bound >= best) break;
-        const auto g = convex::distance<D>(s, detail::FacetShape<D>{&walls_[w]});
-        if (g.distance < best) best = g.distance, best_point = g.b, body_point = g.a, normal = g.normal;
-      }
-      if (best > delta) return;
-      const Vec<D> c = b.centre - best_point;
-      const Vec<D> x = (body_point + best_point) / 2;
-      out.push_back({k, -1, best, b.r_in, direction(normal, c.norm() > 0 ? Vec<D>(c.normalized()) : normal, 1), x - b.centre});
+      std::vector<const Facet<D>*> facets;
+      for (Index w : cand) facets.push_back(&walls_[w]);
+      const auto g = nearest_to_facets(b, facets);
+      if (g.distance > delta) return;
+      const Vec<D> c = b.centre - g.b;
+      const Vec<D> x = (g.a + g.b) / 2;
+      out.push_back({k, -1, g.distance, b.r_in, direction(g.normal, c.norm() > 0 ? Vec<D>(c.normalized()) : g.normal, 1),
+                     x - b.centre});
       return;
     }
     if (b.radius > 0) {
@@ -543,6 +551,32 @@ class ContactGeometry {
       const Vec<D> x = (body_point + best_point) / 2;
       out.push_back({k, -1, best, b.r_in, direction(body_point - best_point, n / nn, b.r_in), x - b.centre});
     }
+  }
+
+  /// The nearest of `facets` to body b's convex shape (GJK; a on the shape, b on the facet,
+  /// the normal from the facet towards the shape), the facets taken in order of a lower bound on
+  /// their distance until it exceeds the best found. The bound: with p the facet's point nearest
+  /// b's centre c and u = (p - c) / |p - c|, the facet lies in u.(y - c) >= |p - c| and the shape
+  /// in u.(x - c) <= h(u), its support value, so their distance is at least |p - c| - h(u).
+  static convex::Distance<D> nearest_to_facets(const CollisionBody<D>& b, const std::vector<const Facet<D>*>& facets) {
+    const convex::Support<D> s = shape(b);
+    std::vector<std::pair<Real, const Facet<D>*>> order;
+    order.reserve(facets.size());
+    for (const Facet<D>* f : facets) {
+      const Vec<D> pc = detail::closest_on_facet(b.centre, *f) - b.centre;
+      const Real r = pc.norm();
+      const Real bound = r > 0 ? r - (pc / r).dot(s.support(Vec<D>(pc / r)) - b.centre) - s.margin()
+                               : -std::numeric_limits<Real>::infinity();
+      order.push_back({bound, f});
+    }
+    std::sort(order.begin(), order.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    convex::Distance<D> best;
+    for (const auto& [bound, f] : order) {
+      if (bound >= best.distance) break;
+      const auto g = convex::distance<D>(s, detail::FacetShape<D>{f});
+      if (g.distance < best.distance) best = g;
+    }
+    return best;
   }
 
   /// The candidate wall facets in order of a lower bound on their distance to body b (its

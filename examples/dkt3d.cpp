@@ -18,7 +18,8 @@
 // How to run: ./dkt3d [--level 1] [--t-end 40] [--output DIR] [--vtu-every 0]
 //             [--checkpoint-every 0] [--restart]    (`--help` lists the options)
 // What it prints: the mesh, a progress line every 10 steps, then the kissing time (the first time
-// the centres are within 1.005 d), the largest tilt of the pair (the angle of the line of centres
+// the centres are within 1.005 d; the spring of range h_body / 2 may hold them farther apart, so
+// the closest approach and its time are printed too), the largest tilt of the pair (the angle of the line of centres
 // against the vertical) and when, where the spheres are at t_end, the remeshes, the steps, the
 // wall and CPU times with their split, the peak memory and the linear solves. It writes
 // DIR/bodies.csv (through alefsi::run: centre, quaternion, velocity, loads, gap per step and
@@ -36,6 +37,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -107,7 +109,7 @@ int main(int argc, char** argv) try {
   std::ofstream pair(o.files.output / "pair.csv", o.files.restart ? std::ios::app : std::ios::trunc);
   if (!o.files.restart) pair << "t,distance,tilt_deg\n";
   pair << std::setprecision(10);
-  Real t_kiss = -1, tilt_max = 0, t_tilt = 0;
+  Real t_kiss = -1, tilt_max = 0, t_tilt = 0, dist_min = std::numeric_limits<Real>::infinity(), t_min = 0;
   RunOptions run_opt;
   run_opt.dt = 1e-2, run_opt.t_end = o.t_end;
   run_opt.tolerance = o.tolerance > 0 ? o.tolerance : 1e-3 / std::pow(2.0, o.level - 1);
@@ -118,6 +120,7 @@ int main(int argc, char** argv) try {
     const Real dist = r.norm();
     const Real tilt = std::acos(std::clamp(std::abs(r[2]) / dist, Real(0), Real(1))) * 180 / std::numbers::pi;
     if (t_kiss < 0 && dist <= 1.005 * d) t_kiss = flow.time();
+    if (dist < dist_min) dist_min = dist, t_min = flow.time();
     if (tilt > tilt_max) tilt_max = tilt, t_tilt = flow.time();
     pair << flow.time() << ',' << dist / d << ',' << tilt << '\n';
   };
@@ -127,7 +130,8 @@ int main(int argc, char** argv) try {
   std::cout << std::setprecision(4);
   if (t_kiss >= 0) std::cout << "kissing (centres within 1.005 d) at t = " << t_kiss;
   else std::cout << "no kiss (centres within 1.005 d) by t = " << flow.time();
-  std::cout << "; largest tilt of the pair " << tilt_max << " deg at t = " << t_tilt << "\n";
+  std::cout << "; closest approach: centres " << dist_min / d << " d apart at t = " << t_min
+            << "; largest tilt of the pair " << tilt_max << " deg at t = " << t_tilt << "\n";
   for (int k = 0; k < 2; ++k)
     std::cout << "  at t = " << flow.time() << ": " << (k == 0 ? "leading " : "trailing") << " sphere at ("
               << flow.body_centre(k).transpose() << "), velocity (" << flow.body_velocity(k).head<3>().transpose()

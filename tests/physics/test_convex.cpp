@@ -15,11 +15,7 @@ using namespace alefsi;
 
 namespace {
 
-Mat<2> rot2(Real a) {
-  Mat<2> Q;
-  Q << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
-  return Q;
-}
+Mat<2> rot2(Real a) { return Eigen::Rotation2D<Real>(a).toRotationMatrix(); }
 Mat<3> rot3(const Vec<3>& axis, Real a) { return Eigen::AngleAxis<Real>(a, axis.normalized()).toRotationMatrix(); }
 
 // the boundary of a convex polygon as segments

@@ -535,7 +535,12 @@ class ContactGeometry {
         if (gap < best) best = gap, best_point = p;
       }
     } else {
-      for (const auto& [bound, w] : facet_order(b, cand)) {
+      // the facets in order of a lower bound on their distance (centre's minus r_out)
+      std::vector<std::pair<Real, Index>> order;
+      order.reserve(cand.size());
+      for (Index w : cand) order.push_back({(b.centre - detail::closest_on_facet(b.centre, walls_[w])).norm() - b.r_out, w});
+      std::sort(order.begin(), order.end());
+      for (const auto& [bound, w] : order) {
         if (bound >= best) break;
         const auto n = detail::nearest_facets<D>(b.surface, {walls_[w]});
         if (n.distance < best) best = n.distance, best_point = n.b, body_point = n.a;
@@ -577,16 +582,6 @@ class ContactGeometry {
       if (g.distance < best.distance) best = g;
     }
     return best;
-  }
-
-  /// The candidate wall facets in order of a lower bound on their distance to body b (its
-  /// centre's minus r_out).
-  std::vector<std::pair<Real, Index>> facet_order(const CollisionBody<D>& b, const std::vector<Index>& cand) const {
-    std::vector<std::pair<Real, Index>> order;
-    order.reserve(cand.size());
-    for (Index w : cand) order.push_back({(b.centre - detail::closest_on_facet(b.centre, walls_[w])).norm() - b.r_out, w});
-    std::sort(order.begin(), order.end());
-    return order;
   }
 
   std::vector<Facet<D>> walls_;

@@ -36,7 +36,7 @@
 /// the cores and `intersecting` set. Contact models floor the gap anyway.
 ///
 ///     const convex::Ellipsoid<2> e{{0.3, 0.1}};
-///     const auto A = convex::placed<2>(convex::support_of<2>(e), {0, 0}, rotation2d(0.4));
+///     const auto A = convex::placed<2>(convex::support_of<2>(e), {0, 0}, Eigen::Rotation2D<Real>(0.4).toRotationMatrix());
 ///     const auto B = convex::placed<2>(convex::support_of<2>(convex::Ball<2>{0.1}), {0.5, 0}, Mat<2>::Identity());
 ///     const convex::Distance<2> d = convex::distance<2>(A, B);  // d.distance, d.a, d.b
 #include <algorithm>

@@ -626,5 +626,17 @@ TEST_CASE("exact buoyancy: a neutrally buoyant sphere in a closed box stays at r
   shape.tag = 5;
   cube.add_body(shape);
   cube.set_gravity(Vec<3>(0, 0, -10), Buoyancy::exact);
-  CHECK_THROWS_WITH(cube.step(0.02), Catch::Contains("exact buoyancy needs disks or spheres: bodies[0] (tag 5)"));
+  CHECK_THROWS_WITH(cube.step(0.02), Catch::Contains("exact buoyancy needs the displaced volume: bodies[0] (tag 5) "
+                                                      "is not a sphere and has no volume"));
+  // given its volume, the same body (no radius, anisotropic inertia) of the fluid's density is
+  // in equilibrium exactly, as the sphere is
+  Flow given(gmsh_mesh("sphere_in_box3d.msh"), {.rho = 1, .mu = 0.1});
+  given.set_velocity(1, [](const Vec<3>&, Real) { return Vec<3>(0, 0, 0); });
+  shape.volume = 4.0 / 3.0 * std::numbers::pi * 0.2 * 0.2 * 0.2;
+  shape.mass = 1.0 * shape.volume;
+  given.add_body(shape);
+  given.set_gravity(Vec<3>(0, 0, -10), Buoyancy::exact);
+  for (int n = 0; n < 3; ++n) given.step(0.02);
+  CHECK(given.body_velocity(0).norm() < 1e-12);
+  CHECK(given.body_hydrodynamic_load(0).norm() < 1e-12);
 }

@@ -65,6 +65,9 @@ struct RigidBody2D {
   /// `angle` is the mesher's Ellipse{centre, a, b, angle}). Set: collision distances and contact
   /// points are the shape's (GJK), not the mesh surface's facets. Empty: the facets'.
   convex::Support<2> shape;
+  /// > 0: the body's exact area, for exact buoyancy (Buoyancy::exact) of a body that is not a
+  /// disk; its centre of buoyancy is taken at the centre of mass (a body of uniform density).
+  Real volume = 0;
 
   bool free() const { return !prescribed; }
 
@@ -82,6 +85,7 @@ struct RigidBody2D {
     }
     ALEFSI_CHECK_ARG(centre.allFinite() && velocity.allFinite(), who, "non-finite initial state");
     ALEFSI_CHECK_ARG(radius >= 0 && std::isfinite(radius), who + ".radius", "must be >= 0 and finite, got ", radius);
+    ALEFSI_CHECK_ARG(volume >= 0 && std::isfinite(volume), who + ".volume", "must be >= 0 and finite, got ", volume);
   }
 };
 
@@ -199,6 +203,9 @@ struct RigidBody3D {
   /// turns to the world), centred at the centre of mass. Set: collision distances and contact
   /// points are the shape's (GJK), not the mesh surface's facets. Empty: the facets'.
   convex::Support<3> shape;
+  /// > 0: the body's exact volume, for exact buoyancy (Buoyancy::exact) of a body that is not a
+  /// sphere; its centre of buoyancy is taken at the centre of mass (a body of uniform density).
+  Real volume = 0;
 
   bool free() const { return !prescribed; }
 
@@ -220,6 +227,7 @@ struct RigidBody3D {
     ALEFSI_CHECK_ARG(centre.allFinite() && velocity.allFinite(), who, "non-finite initial state");
     ALEFSI_CHECK_ARG(external_load.allFinite(), who + ".external_load", "must be finite");
     ALEFSI_CHECK_ARG(radius >= 0 && std::isfinite(radius), who + ".radius", "must be >= 0 and finite, got ", radius);
+    ALEFSI_CHECK_ARG(volume >= 0 && std::isfinite(volume), who + ".volume", "must be >= 0 and finite, got ", volume);
   }
 };
 
@@ -365,6 +373,8 @@ struct RigidBodyAccessors {
   static Velocity external_load(const Body& b) { return b.external_load; }
   /// > 0: a disk / sphere of this radius (exact surface for the remesher, exact contact distances).
   static Real radius(const Body& b) { return b.radius; }
+  /// > 0: the exact area / volume (exact buoyancy of a body that is not a disk / sphere).
+  static Real volume(const Body& b) { return b.volume; }
 };
 
 template <>

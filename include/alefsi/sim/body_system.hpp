@@ -163,18 +163,20 @@ class BodySystem {
   }
 
   /// Exact buoyancy (AleFlow::set_gravity with Buoyancy::exact): each body's weight becomes
-  /// (m - rho_f V) g, V its exact area (disk: pi r^2) or volume (sphere: 4/3 pi r^3), acting at
-  /// its centre; rho_f = 0 restores m g. Disks and spheres only (others are refused by name:
-  /// their centre of buoyancy is not known to be their centre of mass). Massless (force-free)
+  /// (m - rho_f V) g, V its exact area (disk: pi r^2) or volume (sphere: 4/3 pi r^3; any other
+  /// body: the `volume` it was given), acting at its centre; rho_f = 0 restores m g. A body that
+  /// is neither a disk / sphere nor has a volume is refused by name. Massless (force-free)
   /// bodies keep rows without gravity.
   void set_displaced_density(Real rho_f) {
     for (std::size_t k = 0; k < entries_.size(); ++k) {
       auto& e = entries_[k];
       if (M::mass(e.data) == 0) continue;
       const Real r = M::radius(e.data);
-      ALEFSI_CHECK_ARG(rho_f == 0 || r > 0, "gravity", "exact buoyancy needs disks or spheres: bodies[", k, "] (tag ",
-                       M::tag(e.data), ") is neither");
-      e.displaced = rho_f * (D == 2 ? std::numbers::pi * r * r : 4.0 / 3.0 * std::numbers::pi * r * r * r);
+      const Real V = r > 0 ? (D == 2 ? std::numbers::pi * r * r : 4.0 / 3.0 * std::numbers::pi * r * r * r)
+                           : M::volume(e.data);
+      ALEFSI_CHECK_ARG(rho_f == 0 || V > 0, "gravity", "exact buoyancy needs the displaced volume: bodies[", k,
+                       "] (tag ", M::tag(e.data), ") is not a ", D == 2 ? "disk" : "sphere", " and has no volume");
+      e.displaced = rho_f * V;
     }
   }
 
@@ -472,8 +474,13 @@ class BodySystem {
   /// The bodies for a remesher, at t^n.
   std::vector<RemeshBody<D>> remesh_bodies(const std::vector<State>& states) const {
     std::vector<RemeshBody<D>> out;
-    for (std::size_t k = 0; k < entries_.size(); ++k)
-      out.push_back({M::tag(entries_[k].data), states[k].centre[0], M::radius(entries_[k].data)});
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      const Real radius = M::radius(entries_[k].data);
+      Real r_out = radius;
+      if (radius == 0)
+        for (const auto& r0 : states[k].surface) r_out = std::max(r_out, r0.norm());
+      out.push_back({M::tag(entries_[k].data), states[k].centre[0], radius, r_out});
+    }
     return out;
   }
 

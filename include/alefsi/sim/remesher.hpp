@@ -40,6 +40,7 @@ struct RemeshBody {
   int tag = 0;
   Vec<D> centre = Vec<D>::Zero();
   Real radius = 0;  ///< > 0: a disk / sphere, kept exact
+  Real r_out = 0;   ///< the largest distance from the centre to the surface (a disk's radius)
 };
 
 /// What the trigger remembers of the last remesh: the quantities `measure` returned then.

@@ -1,6 +1,7 @@
 // Particulate flow machinery (2D): the collision model (eq. 24 made repulsive, and the
 // spring safeguard), remeshing inside the time loop with transfer of every history level,
-// checkpoint / restart bit for bit across a remesh, and the scene checks.
+// checkpoint / restart bit for bit across a remesh, the scene checks, and whole settling runs
+// (disks, an ellipse).
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -12,8 +13,10 @@
 
 #include "alefsi/mesh/generate/mesher2d.hpp"
 #include "alefsi/physics/collision.hpp"
+#include "alefsi/scenes/settling.hpp"
 #include "alefsi/sim/ale_flow.hpp"
 #include "alefsi/sim/driver.hpp"
+#include "alefsi/sim/remesher2d.hpp"
 
 using namespace alefsi;
 
@@ -249,6 +252,55 @@ TEST_CASE("DKT, coarse: drafting brings the disks together, the collision forces
   CHECK(s.worst_quality > 0.05);  // never a degenerate cell
   // drafting and kissing: from 0.5 apart to within the spring's range (0.25 + 0.08)
   CHECK(closest < 2 * 0.125 + 0.08);
+}
+
+TEST_CASE("Remesher2D: the size function sees a disk's circle and any other body's bounding circle",
+          "[remesh][quick]") {
+  std::vector<Circle> seen;
+  Remesher2D r({.walls = {channel_outline(2, 2)}, .size = [&](const std::vector<Circle>& c) {
+                  seen = c;
+                  return graded_size(c, 0.05, 0.2);
+                },
+                .adapt = {}});
+  const Mesh<2> mesh = channel_with_disks(2, 2, {}, 0.2, 0.2);
+  const std::vector<RemeshBody<2>> bodies{{5, Vec<2>(0.5, 0.5), 0.1, 0.1}, {6, Vec<2>(1.5, 1.2), 0, 0.3}};
+  r.measure(mesh, bodies);
+  REQUIRE(seen.size() == 2);
+  CHECK((seen[0].tag == 5 && seen[0].radius == 0.1 && seen[0].centre == Vec<2>(0.5, 0.5)));
+  CHECK((seen[1].tag == 6 && seen[1].radius == 0.3 && seen[1].centre == Vec<2>(1.5, 1.2)));
+}
+
+TEST_CASE("an ellipse settling in a channel: its first swing is Xia et al.'s (2009)", "[settling][remesh][quick]") {
+  // scenes::SettlingEllipse: Xia et al. (2009, J. Fluid Mech. 625, 249), aspect ratio 2,
+  // blockage 0.25, density ratio 1.1, released at 45 degrees on the centreline. Released, it
+  // turns past the horizontal while it swings out towards a wall: the first extremes of its
+  // angle and of its lateral position, and its speed at t = 0.28 s, against the values read
+  // off Xia et al.'s figures (as digitised in the FEN project's falling_ellipse test): angle
+  // -0.096 pi (-17.3 deg) at y = 21.7 a_f, x = 1.48 a_f at y = 21.6 a_f (a_f = 2a = 0.1 cm the
+  // major axis), U = 1.28 cm/s. The tolerances are the reading's (about 0.5 deg, 0.01 cm,
+  // 0.002 cm, 0.02 cm/s, doubled); this coarse level (h = b / 3 at the body, dt = 2 ms) is
+  // within 0.1 deg and 0.3 % of twice finer (docs/results.md).
+  const scenes::SettlingEllipse scene;
+  AleFlow<FlowConfig<2, TaylorHood, BDF2_BDF2E>> flow(scene.mesh(0.008, 0.04), {.rho = 1, .mu = 0.01});
+  scene.configure(flow, 0.008, 0.04);
+  Real angle_min = 1, y_angle = 0, x_min = 1, y_x = 0, U_028 = 0;
+  RunOptions ro;
+  ro.dt = 2e-3, ro.t_end = 0.3, ro.tolerance = 0, ro.progress_every = 0, ro.log = nullptr;
+  ro.on_step = [&] {
+    const Vec<2> c = flow.body_centre(0);
+    if (const Real a = std::remainder(flow.body_angle(0), std::numbers::pi); a < angle_min) angle_min = a, y_angle = c[1];
+    if (c[0] < x_min) x_min = c[0], y_x = c[1];
+    if (std::abs(flow.time() - 0.28) < 1e-9) U_028 = -flow.body_velocity(0)[1];
+  };
+  const RunSummary s = run(flow, ro);
+  INFO("remeshes " << s.remeshes << ", angle min " << angle_min * 180 / std::numbers::pi << " deg at y " << y_angle
+                   << ", x min " << x_min << " at y " << y_x << ", U(0.28) " << U_028);
+  CHECK(s.remeshes > 0);
+  CHECK(angle_min * 180 / std::numbers::pi == Approx(-0.096 * 180).margin(1.0));
+  CHECK(y_angle == Approx(2.17).margin(0.02));
+  CHECK(x_min == Approx(0.148).margin(0.004));
+  CHECK(y_x == Approx(2.16).margin(0.02));
+  CHECK(U_028 == Approx(1.28).margin(0.04));
 }
 
 TEST_CASE("slip built-ins: tangential projection of Q = -B1 e is the squirmer mode B1 sin(theta)", "[slip][quick]") {

@@ -270,6 +270,28 @@ TEST_CASE("Remesher2D: the size function sees a disk's circle and any other body
   CHECK((seen[1].tag == 6 && seen[1].radius == 0.3 && seen[1].centre == Vec<2>(1.5, 1.2)));
 }
 
+TEST_CASE("a body's convex shape must be its meshed surface: turned, too small or too large is refused",
+          "[scene][quick]") {
+  const scenes::SettlingEllipse scene;
+  auto first_step = [&](const convex::Support<2>& shape) {
+    AleFlow<FlowConfig<2, P1P1Gls, BDF2_BDF2E>> flow(scene.mesh(0.01, 0.05), {.rho = 1, .mu = 0.01, .tau_dt = 1e-3});
+    RigidBody2D b = scene.body();
+    b.shape = shape;
+    flow.add_body(b);
+    for (int tag : {1, 2, 3, 4}) flow.set_velocity(tag, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });
+    flow.step(1e-3);
+  };
+  const Real a = scene.ellipse.a, b = scene.ellipse.b;
+  CHECK_NOTHROW(first_step(convex::support_of<2>(convex::Ellipsoid<2>{Vec<2>(a, b)})));
+  // the semi-axes swapped (the body's angle convention mistaken): the tips lie outside
+  CHECK_THROWS_WITH(first_step(convex::support_of<2>(convex::Ellipsoid<2>{Vec<2>(b, a)})),
+                    Catch::Contains("bodies[0] (tag 5): surface node") && Catch::Contains("outside the shape"));
+  CHECK_THROWS_WITH(first_step(convex::support_of<2>(convex::Ellipsoid<2>{Vec<2>(0.95 * a, 0.95 * b)})),
+                    Catch::Contains("outside the shape"));
+  CHECK_THROWS_WITH(first_step(convex::support_of<2>(convex::Ellipsoid<2>{Vec<2>(1.2 * a, 1.2 * b)})),
+                    Catch::Contains("bodies[0] (tag 5): the shape reaches") && Catch::Contains("too large"));
+}
+
 TEST_CASE("an ellipse settling in a channel: its first swing is Xia et al.'s (2009)", "[settling][remesh][quick]") {
   // scenes::SettlingEllipse: Xia et al. (2009, J. Fluid Mech. 625, 249), aspect ratio 2,
   // blockage 0.25, density ratio 1.1, released at 45 degrees on the centreline. Released, it

@@ -468,6 +468,7 @@ class AleFlow {
       for (std::size_t k = 0; k < bodies_.size(); ++k) body_jacobian_here_[k] = first[k] == disc_.part();
     }
     bodies_.check_radii(mesh_, state_.bodies);
+    bodies_.check_shapes(state_.bodies);
     if (state_.stats.steps == 0) bodies_.check_slip(mesh_, state_.bodies);
     contact_->set_walls(mesh_, bodies_.tags());
     if (state_.stats.steps == 0)

@@ -193,6 +193,57 @@ class BodySystem {
     }
   }
 
+  /// Bodies with a convex shape (not disks / spheres): the shape must be the meshed surface. No
+  /// surface node may lie outside the shape (by 1e-6 r_out), and the shape may not reach beyond
+  /// a node, along the node's normal (the mean of its facets'), by more than half the node's
+  /// longest facet edge: on a smooth surface the sag of the facets is far less, while a shape
+  /// turned the wrong way, too small or too large is refused, naming the body and the node.
+  void check_shapes(const std::vector<State>& states) const {
+    if constexpr (requires(const Body& b) { M::shape(b); }) {
+      for (std::size_t k = 0; k < entries_.size(); ++k) {
+        const auto& e = entries_[k];
+        const auto shape = M::shape(e.data);
+        if (!shape || M::radius(e.data) > 0) continue;
+        const auto& r0 = states[k].surface;  // offsets, in the shape's axes
+        Real r_out = 0;
+        for (const auto& r : r0) r_out = std::max(r_out, r.norm());
+        std::vector<Vec<D>> normal(r0.size(), Vec<D>::Zero());
+        std::vector<Real> edge(r0.size(), 0);
+        for (const auto& f : e.facets) {
+          std::array<std::size_t, D> j;
+          for (int i = 0; i < D; ++i)
+            j[i] = std::size_t(std::lower_bound(e.nodes.begin(), e.nodes.end(), f[i]) - e.nodes.begin());
+          Vec<D> n, mid = Vec<D>::Zero();
+          Real longest = 0;
+          if constexpr (D == 2) {
+            const Vec<2> t = r0[j[1]] - r0[j[0]];
+            n = Vec<2>(t[1], -t[0]), longest = t.norm();
+          } else {
+            n = (r0[j[1]] - r0[j[0]]).cross(r0[j[2]] - r0[j[0]]);
+            for (int i = 0; i < 3; ++i) longest = std::max(longest, (r0[j[(i + 1) % 3]] - r0[j[i]]).norm());
+          }
+          for (int i = 0; i < D; ++i) mid += r0[j[i]] / D;
+          if (n.dot(mid) < 0) n = -n;  // outward: the surface is star-shaped about the centre
+          for (int i = 0; i < D; ++i) normal[j[i]] += n.normalized(), edge[j[i]] = std::max(edge[j[i]], longest);
+        }
+        for (std::size_t j = 0; j < r0.size(); ++j) {
+          const convex::Support<D> node{[p = r0[j]](const Vec<D>&) { return p; }, 0};
+          const Real outside = convex::distance<D>(node, shape).distance;
+          ALEFSI_CHECK_ARG(outside <= 1e-6 * r_out, "body.shape", "bodies[", k, "] (tag ", M::tag(e.data),
+                           "): surface node ", e.nodes[j], " lies ", outside,
+                           " outside the shape: the shape is not the meshed surface (too small, or turned?)");
+          if (normal[j].squaredNorm() == 0) continue;
+          const Vec<D> n = normal[j].normalized();
+          const Real beyond = n.dot(shape.support(n)) + shape.margin() - n.dot(r0[j]);
+          ALEFSI_CHECK_ARG(beyond <= 0.5 * edge[j], "body.shape", "bodies[", k, "] (tag ", M::tag(e.data),
+                           "): the shape reaches ", beyond, " beyond surface node ", e.nodes[j],
+                           " along its normal (more than half its facets' edge ", edge[j],
+                           "): the shape is not the meshed surface (too large, or turned?)");
+        }
+      }
+    }
+  }
+
   /// Disks and spheres with a slip: the slip at every surface node is finite and tangential
   /// (its normal part at most 1 % of the body's largest slip; flux_free_slip's correction is
   /// far smaller). A slip with a normal part would make the body a source or a sink.

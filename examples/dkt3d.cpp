@@ -23,8 +23,9 @@
 // against the vertical) and when, where the spheres are at t_end, the remeshes, the steps, the
 // wall and CPU times with their split, the peak memory and the linear solves. It writes
 // DIR/bodies.csv (through alefsi::run: centre, quaternion, velocity, loads, gap per step and
-// body) and DIR/pair.csv (t, centre distance / d, tilt in degrees), the VTU series
-// (--vtu-every) and checkpoints (--checkpoint-every).
+// body) and DIR/pair.csv (t, centre distance / d, tilt in degrees; a restart keeps its rows up
+// to the checkpoint and counts them in the summary), the VTU series (--vtu-every) and
+// checkpoints (--checkpoint-every).
 #include <alefsi/alefsi.hpp>
 #include <alefsi/app.hpp>
 #include <alefsi/la/krylov.hpp>
@@ -39,6 +40,7 @@
 #include <iostream>
 #include <limits>
 #include <numbers>
+#include <sstream>
 #include <string>
 
 using namespace alefsi;
@@ -106,10 +108,38 @@ int main(int argc, char** argv) try {
   std::cout << "; from t = " << flow.time() << " to " << o.t_end << "\n";
 
   std::filesystem::create_directories(o.files.output);
-  std::ofstream pair(o.files.output / "pair.csv", o.files.restart ? std::ios::app : std::ios::trunc);
-  if (!o.files.restart) pair << "t,distance,tilt_deg\n";
-  pair << std::setprecision(10);
   Real t_kiss = -1, tilt_max = 0, t_tilt = 0, dist_min = std::numeric_limits<Real>::infinity(), t_min = 0;
+  auto record = [&](Real t, Real dist, Real tilt) {  // dist in units of d
+    if (t_kiss < 0 && dist <= 1.005) t_kiss = t;
+    if (dist < dist_min) dist_min = dist, t_min = t;
+    if (tilt > tilt_max) tilt_max = tilt, t_tilt = t;
+  };
+  // pair.csv: on a restart its rows up to the checkpoint's time are kept (and counted in the
+  // summary), the later ones (written after the checkpoint, before the run stopped) dropped;
+  // the kept rows go to a new file that replaces the old one whole
+  const std::filesystem::path pair_file = o.files.output / "pair.csv";
+  std::string kept = "t,distance,tilt_deg\n";
+  if (std::ifstream old{pair_file}; o.files.restart && old) {
+    std::string line;
+    for (int n = 1; std::getline(old, line); ++n) {
+      if (n == 1 && line.rfind("t,", 0) == 0) continue;  // the header
+      Real t, dist, tilt;
+      char c1, c2;
+      std::istringstream in(line);
+      if (!(in >> t >> c1 >> dist >> c2 >> tilt) || c1 != ',' || c2 != ',')
+        throw IoError(pair_file.string() + ":" + std::to_string(n) + ": not a row 't,distance,tilt_deg': '" + line + "'");
+      if (t > flow.time() + 1e-12 * std::max(Real(1), flow.time())) break;
+      record(t, dist, tilt);
+      kept += line + '\n';
+    }
+  }
+  {
+    const std::filesystem::path tmp = pair_file.string() + ".tmp";
+    std::ofstream(tmp, std::ios::trunc) << kept;
+    std::filesystem::rename(tmp, pair_file);
+  }
+  std::ofstream pair(pair_file, std::ios::app);
+  pair << std::setprecision(10);
   RunOptions run_opt;
   run_opt.dt = 1e-2, run_opt.t_end = o.t_end;
   run_opt.tolerance = o.tolerance > 0 ? o.tolerance : 1e-3 / std::pow(2.0, o.level - 1);
@@ -119,10 +149,8 @@ int main(int argc, char** argv) try {
     const alefsi::Vec<3> r = flow.body_centre(1) - flow.body_centre(0);  // leading to trailing
     const Real dist = r.norm();
     const Real tilt = std::acos(std::clamp(std::abs(r[2]) / dist, Real(0), Real(1))) * 180 / std::numbers::pi;
-    if (t_kiss < 0 && dist <= 1.005 * d) t_kiss = flow.time();
-    if (dist < dist_min) dist_min = dist, t_min = flow.time();
-    if (tilt > tilt_max) tilt_max = tilt, t_tilt = flow.time();
-    pair << flow.time() << ',' << dist / d << ',' << tilt << '\n';
+    record(flow.time(), dist / d, tilt);
+    pair << flow.time() << ',' << dist / d << ',' << tilt << std::endl;  // whole rows, should the run stop
   };
   const RunSummary sum = run(flow, run_opt);
 
@@ -130,7 +158,7 @@ int main(int argc, char** argv) try {
   std::cout << std::setprecision(4);
   if (t_kiss >= 0) std::cout << "kissing (centres within 1.005 d) at t = " << t_kiss;
   else std::cout << "no kiss (centres within 1.005 d) by t = " << flow.time();
-  std::cout << "; closest approach: centres " << dist_min / d << " d apart at t = " << t_min
+  std::cout << "; closest approach: centres " << dist_min << " d apart at t = " << t_min
             << "; largest tilt of the pair " << tilt_max << " deg at t = " << t_tilt << "\n";
   for (int k = 0; k < 2; ++k)
     std::cout << "  at t = " << flow.time() << ": " << (k == 0 ? "leading " : "trailing") << " sphere at ("

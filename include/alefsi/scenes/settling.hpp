@@ -27,6 +27,23 @@
 
 namespace alefsi::scenes {
 
+namespace detail {
+/// Remeshing of the channel [0, width] x [0, height], the size graded from h_body at the
+/// bodies' current circles (a non-disk body's bounding circle) to h_far.
+inline RemeshOptions channel_remeshing(Real width, Real height, bool enabled, Real h_body, Real h_far) {
+  return {.enabled = enabled,
+          .walls = {channel_outline(width, height)},
+          .size = [=](const std::vector<Circle>& now) { return graded_size(now, h_body, h_far); },
+          .adapt = {}};
+}
+/// No-slip on the channel's four walls.
+template <class Flow>
+void no_slip_channel(Flow& flow) {
+  for (int tag : {tags::bottom, tags::right, tags::top, tags::left})
+    flow.set_velocity(tag, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });
+}
+}  // namespace detail
+
 struct SettlingDisks {
   Real width = 2, height = 6;  ///< the channel (cm)
   std::vector<Circle> disks;   ///< centres, radii and tags at t0
@@ -52,10 +69,7 @@ struct SettlingDisks {
   Mesh<2> mesh(Real h_body, Real h_far) const { return channel_with_disks(width, height, disks, h_body, h_far); }
   /// Remeshing with the size graded from h_body at the disks' current places to h_far.
   RemeshOptions remesh_options(Real h_body, Real h_far) const {
-    return {.enabled = remeshing,
-            .walls = {channel_outline(width, height)},
-            .size = [=](const std::vector<Circle>& now) { return graded_size(now, h_body, h_far); },
-            .adapt = {}};
+    return detail::channel_remeshing(width, height, remeshing, h_body, h_far);
   }
   /// eq. (24) with delta = R/10, plus the Glowinski spring (collision.hpp).
   CollisionOptions collision_options() const {
@@ -64,8 +78,7 @@ struct SettlingDisks {
   /// No-slip walls, the free disks, gravity, collisions and remeshing (for sizes h_body, h_far).
   template <class Flow>
   void configure(Flow& flow, Real h_body, Real h_far) const {
-    for (int tag : {tags::bottom, tags::right, tags::top, tags::left})
-      flow.set_velocity(tag, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });
+    detail::no_slip_channel(flow);
     for (const Circle& c : disks) flow.add_body(disk_body(c.tag, c.centre, c.radius, rho_s));
     flow.set_gravity(gravity);
     if (collisions) flow.set_collisions(collision_options());
@@ -125,10 +138,7 @@ struct SettlingEllipse {
     return b;
   }
   RemeshOptions remesh_options(Real h_body, Real h_far) const {
-    return {.enabled = remeshing,
-            .walls = {channel_outline(width, height)},
-            .size = [=](const std::vector<Circle>& now) { return graded_size(now, h_body, h_far); },
-            .adapt = {}};
+    return detail::channel_remeshing(width, height, remeshing, h_body, h_far);
   }
   /// eq. (24) with delta = 0.1 R-bar, plus the spring.
   CollisionOptions collision_options() const {
@@ -137,8 +147,7 @@ struct SettlingEllipse {
   template <class Flow>
   void configure(Flow& flow, Real h_body, Real h_far) const {
     validate();
-    for (int tag : {tags::bottom, tags::right, tags::top, tags::left})
-      flow.set_velocity(tag, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });
+    detail::no_slip_channel(flow);
     flow.add_body(body());
     flow.set_gravity(gravity, Buoyancy::exact);
     if (collisions) flow.set_collisions(collision_options());

@@ -205,8 +205,7 @@ class BodySystem {
         const auto shape = M::shape(e.data);
         if (!shape || M::radius(e.data) > 0) continue;
         const auto& r0 = states[k].surface;  // offsets, in the shape's axes
-        Real r_out = 0;
-        for (const auto& r : r0) r_out = std::max(r_out, r.norm());
+        const Real r_out = reach(states[k]);
         std::vector<Vec<D>> normal(r0.size(), Vec<D>::Zero());
         std::vector<Real> edge(r0.size(), 0);
         for (const auto& f : e.facets) {
@@ -509,7 +508,7 @@ class BodySystem {
         }
       }
       c.r_in = std::numeric_limits<Real>::infinity();
-      for (const auto& r0 : s.surface) c.r_out = std::max(c.r_out, r0.norm());
+      c.r_out = reach(s);
       for (const auto& f : e.facets) {
         std::array<Vec<D>, D> x;
         for (int i = 0; i < D; ++i) x[i] = at(f[i]);
@@ -527,10 +526,7 @@ class BodySystem {
     std::vector<RemeshBody<D>> out;
     for (std::size_t k = 0; k < entries_.size(); ++k) {
       const Real radius = M::radius(entries_[k].data);
-      Real r_out = radius;
-      if (radius == 0)
-        for (const auto& r0 : states[k].surface) r_out = std::max(r_out, r0.norm());
-      out.push_back({M::tag(entries_[k].data), states[k].centre[0], radius, r_out});
+      out.push_back({M::tag(entries_[k].data), states[k].centre[0], radius, radius > 0 ? radius : reach(states[k])});
     }
     return out;
   }
@@ -580,6 +576,13 @@ class BodySystem {
   }
 
  private:
+  // The largest distance from the centre to a surface node.
+  static Real reach(const State& s) {
+    Real r = 0;
+    for (const auto& r0 : s.surface) r = std::max(r, r0.norm());
+    return r;
+  }
+
   struct Entry {
     Body data;
     Index extra = -1;                               // first of its n_dof extra unknowns (free bodies)

@@ -35,6 +35,7 @@
 #include <numbers>
 #include <string>
 #include <tuple>
+#include <vector>
 
 #include "alefsi/core/error.hpp"
 #include "alefsi/core/types.hpp"
@@ -165,6 +166,19 @@ inline std::function<Vec<2>(const Vec<2>&)> squirmer_slip(Real B1, Real B2, cons
   };
 }
 
+/// 3D: u_s = (B1 + B2 cos(theta)) ((e.n) n - e), theta the angle of n = r / |r| from the unit
+/// swimming axis e (sin(theta) e_theta = (e.n) n - e). Unbounded: swims along e at
+/// U = 2 B1 / 3 (Blake 1971); B2 (pusher < 0, puller > 0) adds no speed.
+inline std::function<Vec<3>(const Vec<3>&)> squirmer_slip(Real B1, Real B2, const Vec<3>& e) {
+  ALEFSI_CHECK_ARG(std::isfinite(B1) && std::isfinite(B2), "B1", "modes must be finite");
+  ALEFSI_CHECK_ARG(std::abs(e.norm() - 1) < 1e-12, "e", "swimming axis must be a unit vector");
+  return [=](const Vec<3>& r) -> Vec<3> {
+    const Vec<3> n = r.normalized();
+    const Real c = n.dot(e);
+    return (B1 + B2 * c) * (c * n - e);
+  };
+}
+
 /// Rows of H(x) for a point at offset r = x - x_g: u_c = sum_C H(c, C) Z_C.
 inline std::array<Vec<3>, 2> rigid_rows(const Vec<2>& r) {
   return {Vec<3>(1.0, 0.0, -r[1]), Vec<3>(0.0, 1.0, r[0])};
@@ -256,6 +270,32 @@ inline RigidBody3D massless_sphere(int tag, const Vec<3>& centre, Real radius) {
   return b;
 }
 
+/// The flux of the interpolant (velocity degree 1 or 2) of a field f through a body's polygonal
+/// surface: `facets` are its facets' corners as offsets from the centre (any frame, f in the same
+/// one), oriented outwards (away from the centre). 3D: a flat triangle's flux is |f| / 3 times
+/// the sum of f.n over its edge midpoints (degree 2: the corner weights vanish) or its corners
+/// (degree 1); 2D: an edge's is Simpson's rule (degree 2) or the trapezoidal rule (degree 1).
+template <int D, class F>
+Real surface_flux(const std::vector<std::array<Vec<D>, D>>& facets, const F& f, int velocity_degree) {
+  Real phi = 0;
+  for (const auto& x : facets) {
+    Vec<D> n;  // outward, |n| = the facet's measure
+    if constexpr (D == 2) n = Vec<2>(x[1][1] - x[0][1], x[0][0] - x[1][0]);
+    else n = 0.5 * (x[1] - x[0]).cross(x[2] - x[0]);
+    Vec<D> sum = Vec<D>::Zero();
+    for (const auto& p : x) sum += p;
+    if (n.dot(sum) < 0) n = -n;
+    if constexpr (D == 2) {
+      phi += velocity_degree == 2 ? n.dot(f(x[0]) + 4 * f(Vec<2>(0.5 * (x[0] + x[1]))) + f(x[1])) / 6
+                                  : n.dot(f(x[0]) + f(x[1])) / 2;
+    } else {
+      for (int i = 0; i < 3; ++i)
+        phi += n.dot(velocity_degree == 2 ? f(Vec<3>(0.5 * (x[i] + x[(i + 1) % 3]))) : f(x[i])) / 3;
+    }
+  }
+  return phi;
+}
+
 /// The body's slip made compatible with incompressibility on its mesh: returns
 /// u_s(r) - c n(r), n = r / |r|, with c such that the discrete flux of the new slip through the
 /// body's polygonal surface (facets tagged body.tag in `mesh`, at the body's initial place) is
@@ -267,8 +307,9 @@ inline RigidBody3D massless_sphere(int tag, const Vec<3>& centre, Real radius) {
 /// absorbs as a point source, polluting the body's velocity (measured on a mirror-symmetric
 /// mesh with the hemisphere slip of paper 6.1, h = R / 3: V_y = 6e-5 instead of 0). The
 /// correction is a uniform normal velocity of O(h^2), which exerts no force or torque on a
-/// sphere. Flux of the interpolant on a flat facet f: |f| / 3 times the sum over its edge
-/// midpoints (velocity degree 2: the vertex weights vanish) or over its vertices (degree 1).
+/// sphere (surface_flux gives the discrete flux). AleFlow applies the same correction itself in
+/// a closed domain, on every mesh it runs on (after each remesh too: BodySystem::remove_slip_flux);
+/// this function is for a slip used on a fixed mesh outside a flow, or to see the leak.
 ///
 ///     squirmer.slip = tangential_slip(Vec<3>(-1, 0, 0), Vec<3>(1, 0, 0));
 ///     squirmer.slip = flux_free_slip(squirmer, mesh);   // before flow.add_body(squirmer)
@@ -278,26 +319,16 @@ inline std::function<Vec<3>(const Vec<3>&)> flux_free_slip(const RigidBody3D& bo
   ALEFSI_CHECK_ARG(velocity_degree == 1 || velocity_degree == 2, "velocity_degree", "must be 1 or 2, got ",
                    velocity_degree);
   const auto slip = body.slip;
-  const Eigen::Quaternion<Real> q = body.orientation;
-  auto flux = [&](const std::function<Vec<3>(const Vec<3>&)>& f) {
-    Real phi = 0;
-    bool any = false;
-    for (Index k : mesh.boundary_facets()) {
-      if (mesh.facet_tag(k) != body.tag) continue;
-      any = true;
-      const auto& fv = mesh.facet(k);
-      const std::array<Vec<3>, 3> x{mesh.node(fv[0]), mesh.node(fv[1]), mesh.node(fv[2])};
-      Vec<3> n = 0.5 * (x[1] - x[0]).cross(x[2] - x[0]);  // |n| = area
-      if (n.dot(x[0] + x[1] + x[2] - 3 * body.centre) < 0) n = -n;
-      for (int i = 0; i < 3; ++i) {
-        const Vec<3> p = velocity_degree == 2 ? Vec<3>(0.5 * (x[i] + x[(i + 1) % 3])) : x[i];
-        phi += n.dot(q * f(q.conjugate() * (p - body.centre))) / 3;
-      }
-    }
-    ALEFSI_CHECK_ARG(any, "body.tag", "no boundary facet of the mesh has tag ", body.tag);
-    return phi;
-  };
-  const Real c = flux(slip) / flux([](const Vec<3>& r) { return Vec<3>(r.normalized()); });
+  std::vector<std::array<Vec<3>, 3>> facets;  // body frame
+  for (Index k : mesh.boundary_facets()) {
+    if (mesh.facet_tag(k) != body.tag) continue;
+    std::array<Vec<3>, 3> x;
+    for (int i = 0; i < 3; ++i) x[i] = body.orientation.conjugate() * (mesh.node(mesh.facet(k)[i]) - body.centre);
+    facets.push_back(x);
+  }
+  ALEFSI_CHECK_ARG(!facets.empty(), "body.tag", "no boundary facet of the mesh has tag ", body.tag);
+  const Real c = surface_flux<3>(facets, slip, velocity_degree) /
+                 surface_flux<3>(facets, [](const Vec<3>& r) { return Vec<3>(r.normalized()); }, velocity_degree);
   if (removed) *removed = c;
   return [slip, c](const Vec<3>& r) { return Vec<3>(slip(r) - c * r.normalized()); };
 }

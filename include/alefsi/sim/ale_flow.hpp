@@ -251,6 +251,9 @@ class AleFlow {
   Vec<D> body_centre(std::size_t k) const { return state_.bodies.at(k).centre[0]; }
   /// Z: (V1, V2, w3) in 2D, (V, w) in 3D.
   BodyVelocity body_velocity(std::size_t k) const { return state_.bodies.at(k).velocity[0]; }
+  /// The uniform normal speed removed from body k's slip on the current mesh so that its
+  /// discrete flux vanishes (closed domains only, else 0; BodySystem::remove_slip_flux).
+  Real slip_flux_removed(std::size_t k) const { return bodies_.slip_flux_removed(k); }
   /// The angle (2D) or the unit quaternion mapping body axes to world axes (3D).
   BodyOrientation body_orientation(std::size_t k) const { return state_.bodies.at(k).orientation[0]; }
   Real body_angle(std::size_t k) const
@@ -467,6 +470,9 @@ class AleFlow {
       body_jacobian_here_.assign(bodies_.size(), 0);
       for (std::size_t k = 0; k < bodies_.size(); ++k) body_jacobian_here_[k] = first[k] == disc_.part();
     }
+    // a closed domain needs each slip discretely flux-free on this mesh (on flat facets: curved
+    // cells carry their slip as given)
+    bodies_.remove_slip_flux(state_.bodies, Space::VelocityElement::degree, disc_.pressure_pinned() && !geometry_);
     bodies_.check_radii(mesh_, state_.bodies);
     bodies_.check_shapes(state_.bodies);
     if (state_.stats.steps == 0) bodies_.check_slip(mesh_, state_.bodies);

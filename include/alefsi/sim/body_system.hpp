@@ -254,7 +254,7 @@ class BodySystem {
       Index worst = -1;
       for (Index v : e.nodes) {
         const Vec<D> r = M::to_body(mesh.node(v) - states[k].centre[0], states[k].orientation[0], e.data);
-        const Vec<D> us = M::slip(e.data, r);
+        const Vec<D> us = slip(e, r);
         ALEFSI_CHECK_ARG(us.allFinite(), "body.slip", "bodies[", k, "] (tag ", M::tag(e.data),
                          "): the slip is not finite at surface node ", v);
         largest = std::max(largest, us.norm());
@@ -266,6 +266,35 @@ class BodySystem {
                        ", the largest slip ", largest);
     }
   }
+
+  /// In a closed domain (`closed`: every boundary velocity given, the pressure pinned) the
+  /// discrete continuity equations sum to "no net flux through the boundary", which the
+  /// interpolant of a rigid velocity meets exactly and that of a slip tangent to the exact
+  /// surface does not: through the flat facets it leaks an O(h^2) flux, which the pinned
+  /// pressure DOF would absorb as a point source. So each body's slip is applied less c n,
+  /// n = r / |r|, c = Phi[u_s] / Phi[n] with Phi the discrete flux through its facets on this
+  /// mesh (surface_flux, in the body frame of its surface offsets): the same c while the mesh
+  /// moves (the surface moves rigidly), recomputed after each remesh. Elsewhere c = 0. Call
+  /// after `attach`, with the surface offsets of `states` on this mesh.
+  void remove_slip_flux(const std::vector<State>& states, int velocity_degree, bool closed) {
+    for (std::size_t k = 0; k < entries_.size(); ++k) {
+      auto& e = entries_[k];
+      e.slip_flux = 0;
+      if (!closed || !M::has_slip(e.data)) continue;
+      std::vector<std::array<Vec<D>, D>> facets;
+      facets.reserve(e.facets.size());
+      for (const auto& f : e.facets) {
+        std::array<Vec<D>, D> x;
+        for (int i = 0; i < D; ++i)
+          x[i] = states[k].surface[std::size_t(std::lower_bound(e.nodes.begin(), e.nodes.end(), f[i]) - e.nodes.begin())];
+        facets.push_back(x);
+      }
+      const Real through = surface_flux<D>(facets, [](const Vec<D>& r) { return Vec<D>(r.normalized()); }, velocity_degree);
+      e.slip_flux = surface_flux<D>(facets, [&](const Vec<D>& r) { return Vec<D>(M::slip(e.data, r)); }, velocity_degree) / through;
+    }
+  }
+  /// The uniform normal speed c removed from body k's slip on this mesh (remove_slip_flux).
+  Real slip_flux_removed(std::size_t k) const { return entries_.at(k).slip_flux; }
 
   // ---- one step ---------------------------------------------------------------------------
 
@@ -332,9 +361,8 @@ class BodySystem {
       if (c.body_velocity[2] != 0) Zx += c.body_velocity[2] * s.velocity[2];
       for (Index i : e.dofs) {
         const Vec<D> r = vel.point(i, Xn1) - e.xg_next;
-        Vec<D> us = M::has_slip(e.data)
-                        ? M::to_world(M::slip(e.data, M::to_body(r, e.th_next, e.data)), e.th_next, e.data)
-                        : Vec<D>::Zero();
+        Vec<D> us = M::has_slip(e.data) ? M::to_world(slip(e, M::to_body(r, e.th_next, e.data)), e.th_next, e.data)
+                                        : Vec<D>::Zero();
         const auto H = M::rows(r);
         if (!free) {
           for (int d = 0; d < D; ++d) cons.set_fixed_value(space.velocity_field(i, d), H[d].dot(Zp) + us[d]);
@@ -567,7 +595,7 @@ class BodySystem {
           const Vec<D> v =
               M::velocity(s.velocity[l], r) +
               (M::has_slip(e.data)
-                   ? Vec<D>(M::to_world(M::slip(e.data, M::to_body(r, s.orientation[l], e.data)), s.orientation[l], e.data))
+                   ? Vec<D>(M::to_world(slip(e, M::to_body(r, s.orientation[l], e.data)), s.orientation[l], e.data))
                    : Vec<D>(Vec<D>::Zero()));
           for (int d = 0; d < D; ++d) U[l][space.velocity_field(i, d)] = v[d];
         }
@@ -592,11 +620,14 @@ class BodySystem {
     std::vector<Index> cells;                       // cells with a surface velocity DOF (driven bodies)
     std::vector<typename Mesh<D>::Facet> facets;    // surface facets
     Real displaced = 0;                             // fluid mass of its exact volume (exact buoyancy), else 0
+    Real slip_flux = 0;                             // normal speed removed from the slip (remove_slip_flux)
     // the step's prediction
     Velocity Zhat = Velocity::Zero();               // extrapolated (or given) velocity
     Vec<D> xg_next = Vec<D>::Zero();                // centre at t^{n+1}
     Orientation th_next{};                          // orientation at t^{n+1}
   };
+  // The slip applied at body-frame offset r: the body's, less the flux correction.
+  static Vec<D> slip(const Entry& e, const Vec<D>& r) { return M::slip(e.data, r) - e.slip_flux * r.normalized(); }
   // M delta_l Z^{n+1} / dt (+ w x I_w w in 3D), at the orientation for t^{n+1}.
   static Velocity inertia(const Entry& e, const State& s, const StepCoefficients& c, const Velocity& Zn1) {
     const auto& a = c.flow_bdf;

@@ -80,6 +80,24 @@ TEST_CASE("time is counted, not summed: t_end on the step grid is reached by ste
   CHECK(run(*off, quiet(0.01, 0.1205)).steps == 2);
 }
 
+TEST_CASE("stop_when ends a run at the first step where it holds, with that step's summary and checkpoint",
+          "[reliability][checkpoint][quick]") {
+  const TempDir dir("alefsi_stop_when");
+  auto flow = annulus_flow(annulus_mesh(0.25, 1.0, 2, 16));
+  RunOptions ro = quiet(0.01, 0.3);
+  ro.output = dir.path, ro.checkpoint_every = 100;  // no checkpoint but the last
+  int calls = 0;
+  ro.stop_when = [&] { return ++calls, flow->time() >= 0.05; };
+  const RunSummary s = run(*flow, ro);
+  CHECK(s.steps == 5);
+  CHECK(calls == 5);
+  CHECK(s.t == 0.05);
+  CHECK(flow->time() == 0.05);
+  auto fresh = annulus_flow(read_checkpoint_mesh<2>(dir.path / "checkpoint.bin"));
+  fresh->load_checkpoint(dir.path / "checkpoint.bin");
+  check_same_state(*fresh, *flow);
+}
+
 TEST_CASE("adaptive by default for the BDF schemes: the steps land on t_end and on land_on times",
           "[reliability][adaptive][quick]") {
   RunOptions ro;

@@ -113,6 +113,10 @@ struct RunOptions {
   bool writer = true;
   /// Called after every accepted step (e.g. extra monitoring); may throw to stop the run.
   std::function<void()> on_step = {};
+  /// Checked after every accepted step: true ends the run at that step as if it were t_end
+  /// (with checkpoints on, one is written there), e.g. once a body has arrived. Under MPI it must give the same answer on every rank (a function of the
+  /// flow's state does). Empty: the run ends at t_end.
+  std::function<bool()> stop_when = {};
 
   void validate() const {
     ALEFSI_CHECK_ARG(dt > 0 && std::isfinite(dt), "dt", "time step must be positive and finite, got ", dt);
@@ -405,7 +409,8 @@ RunSummary run(Flow& flow, const RunOptions& options) {
       csv << '\n' << std::flush;
     }
     const int n = flow.stats().steps;
-    const bool last = left() <= 1e-9 * opt.dt;
+    const bool stop = opt.stop_when && opt.stop_when();
+    const bool last = stop || left() <= 1e-9 * opt.dt;
     if (pvd && n % opt.vtu_every == 0) write_vtu_now();
     if (checkpoint_every > 0 && (n % checkpoint_every == 0 || last))  // (the same on every process)
       together([&] {
@@ -422,6 +427,7 @@ RunSummary run(Flow& flow, const RunOptions& options) {
         << " s  ETA " << (frac > 0 ? el * (1 - frac) / frac : 0.0) << " s";
       log(s.str());
     }
+    if (stop) break;
   }
   sum.t = flow.time();
   sum.remeshes = flow.stats().remeshes;

@@ -112,12 +112,17 @@ void configure(Flow& flow, const Scene& scene, const Settings& o, Real z, const 
 }
 
 // The steady squirmer at height z on a fresh mesh: one step on the fixed mesh (BDF2's first step
-// from rest is backward Euler, whose mass term vanishes with rho -> 0).
+// from rest is backward Euler, whose mass term vanishes with rho -> 0). Prints the mesh and the
+// solve.
 Vec<6> steady(const Scene& scene, const Settings& o, Real z) {
   Flow flow(scene.mesh(z), {.rho = rho, .mu = mu, .linearisation = Linearisation::semi_implicit});
   configure(flow, scene, o, z, Vec<6>::Zero());
   flow.set_prescribed_mesh_velocity([](const alefsi::Vec<3>&, Real) { return alefsi::Vec<3>(0, 0, 0); });
-  flow.step(1.0);
+  const StepReport rep = flow.step(1.0);
+  std::cout << "  steady at z = " << std::setprecision(4) << z << " (" << flow.mesh().n_cells() << " tetrahedra, "
+            << flow.space().n_field() + Flow::body_dofs << " unknowns, " << rep.linear.iterative_iterations
+            << " GMRES iterations): V_z / U = " << std::setprecision(6) << flow.body_velocity(0)[2] / (2 * o.B1 / 3)
+            << std::endl;
   return flow.body_velocity(0);
 }
 
@@ -143,8 +148,6 @@ int main(int argc, char** argv) try {
   for (int i = 0; i < o.references; ++i) {
     const Real z = o.references == 1 ? o.z0 : o.z0 + (0.5 * o.length - o.z0) * i / (o.references - 1);
     refs.emplace_back(z, steady(scene, o, z));
-    std::cout << "  steady at z = " << std::setprecision(4) << z << ": V_z / U = " << std::setprecision(6)
-              << refs.back().second[2] / U << "\n";
   }
   const Real t_refs = std::chrono::duration<Real>(std::chrono::steady_clock::now() - ref0).count();
   if (o.steady_only) {

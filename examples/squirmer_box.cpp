@@ -80,8 +80,8 @@ bool parse(int argc, char** argv, Settings& o) {
   ALEFSI_CHECK_ARG(o.level >= 0.5 && o.level <= 4, "--level", "must be in [0.5, 4], got ", o.level);
   ALEFSI_CHECK_ARG(o.width > 2 * d, "--width", "must exceed d = 1, with room for the mesh, got ", o.width);
   ALEFSI_CHECK_ARG(o.z0 > a + 0.1 && 2 * o.z0 < o.length - 0.5, "--z0",
-                   "the sphere must start clear of the floor (z0 > 0.6) and below the middle (z0 < (L - 0.5) / 2), got ",
-                   o.z0);
+                   "the sphere must start clear of the floor (z0 > 0.6) and below the middle "
+                   "(z0 < (L - 0.5) / 2), got ", o.z0);
   ALEFSI_CHECK_ARG(o.B1 > 0 && std::isfinite(o.B1), "--B1", "must be positive (it swims up), got ", o.B1);
   ALEFSI_CHECK_ARG(o.references >= 1, "--references", "must be >= 1, got ", o.references);
   opt.print(std::cout);
@@ -104,7 +104,8 @@ struct Scene {
 
 // No-slip walls, the massless squirmer at height z with velocity Z0 at t0.
 void configure(Flow& flow, const Scene& scene, const Settings& o, Real z, const Vec<6>& Z0) {
-  for (int t : scene.box.tags) flow.set_velocity(t, [](const alefsi::Vec<3>&, Real) { return alefsi::Vec<3>(0, 0, 0); });
+  for (int t : scene.box.tags)
+    flow.set_velocity(t, [](const alefsi::Vec<3>&, Real) { return alefsi::Vec<3>(0, 0, 0); });
   RigidBody3D body = massless_sphere(sphere_tag, alefsi::Vec<3>(0, 0, z), a);
   body.slip = squirmer_slip(o.B1, o.B2, e_z);
   body.velocity = Z0;

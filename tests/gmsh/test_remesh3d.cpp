@@ -280,7 +280,8 @@ TEST_CASE("a squirmer swimming up a closed box through remeshes: its slip made f
   RigidBody3D body = massless_sphere(7, start, a);
   body.slip = squirmer_slip(B1, 0, e);
   flow.add_body(body);
-  flow.set_remesher(std::make_unique<Remesher3D>(Remesh3DOptions{.box = box, .size = size, .tolerance = 1.0, .mesher = {}}));
+  flow.set_remesher(
+      std::make_unique<Remesher3D>(Remesh3DOptions{.box = box, .size = size, .tolerance = 1.0, .mesher = {}}));
   std::vector<Real> removed;
   Real speed_mid = 0, off_mid = 1;
   for (int n = 0; n < 12; ++n) {

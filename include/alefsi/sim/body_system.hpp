@@ -285,12 +285,15 @@ class BodySystem {
       facets.reserve(e.facets.size());
       for (const auto& f : e.facets) {
         std::array<Vec<D>, D> x;
-        for (int i = 0; i < D; ++i)
-          x[i] = states[k].surface[std::size_t(std::lower_bound(e.nodes.begin(), e.nodes.end(), f[i]) - e.nodes.begin())];
+        for (int i = 0; i < D; ++i) {
+          const auto j = std::lower_bound(e.nodes.begin(), e.nodes.end(), f[i]) - e.nodes.begin();
+          x[i] = states[k].surface[std::size_t(j)];
+        }
         facets.push_back(x);
       }
-      const Real through = surface_flux<D>(facets, [](const Vec<D>& r) { return Vec<D>(r.normalized()); }, velocity_degree);
-      e.slip_flux = surface_flux<D>(facets, [&](const Vec<D>& r) { return Vec<D>(M::slip(e.data, r)); }, velocity_degree) / through;
+      auto radial = [](const Vec<D>& r) { return Vec<D>(r.normalized()); };
+      auto given = [&](const Vec<D>& r) { return Vec<D>(M::slip(e.data, r)); };
+      e.slip_flux = surface_flux<D>(facets, given, velocity_degree) / surface_flux<D>(facets, radial, velocity_degree);
     }
   }
   /// The uniform normal speed c removed from body k's slip on this mesh (remove_slip_flux).

@@ -114,8 +114,9 @@ struct RunOptions {
   /// Called after every accepted step (e.g. extra monitoring); may throw to stop the run.
   std::function<void()> on_step = {};
   /// Checked after every accepted step: true ends the run at that step as if it were t_end
-  /// (with checkpoints on, one is written there), e.g. once a body has arrived. Under MPI it must give the same answer on every rank (a function of the
-  /// flow's state does). Empty: the run ends at t_end.
+  /// (with checkpoints on, one is written there), e.g. once a body has arrived. Under MPI it
+  /// must give the same answer on every rank (a function of the flow's state does). Empty: the
+  /// run ends at t_end.
   std::function<bool()> stop_when = {};
 
   void validate() const {

@@ -400,6 +400,31 @@ Vec<6> stress_load(const SquirmerFlow& flow, int tag, Real mu) {
 }
 }  // namespace
 
+TEST_CASE("3D squirmer modes: tangential, -B1 e on the equator, surface mean -2 B1 / 3 e (Blake's speed); a "
+          "non-unit axis refused",
+          "[bodies3d][squirmer][quick]") {
+  const Vec<3> e = Vec<3>(1, 2, 2) / 3;
+  const Real B1 = 1.5, B2 = -0.7, R = 0.5;
+  const auto us = squirmer_slip(B1, B2, e);
+  // the six points +-x, +-y, +-z are a spherical 3-design: their average is the surface mean of
+  // any polynomial of degree <= 3 in n, as (B1 + B2 (e.n)) ((e.n) n - e) is; the unbounded
+  // squirmer swims at V = -<u_s> = 2 B1 / 3 e, B2 adding nothing (Blake 1971)
+  Vec<3> mean = Vec<3>::Zero();
+  for (int a = 0; a < 3; ++a)
+    for (Real side : {-1.0, 1.0}) {
+      Vec<3> n = Vec<3>::Zero();
+      n[a] = side;
+      const Vec<3> u = us(R * n);
+      CHECK(std::abs(u.dot(n)) < 1e-15);  // tangential
+      mean += u / 6;
+    }
+  CHECK((mean + 2 * B1 / 3 * e).norm() < 1e-14);
+  CHECK((us(R * e.unitOrthogonal()) + B1 * e).norm() < 1e-14);  // the equator: B1 sin(90 deg) e_theta
+  CHECK((us(R * e)).norm() < 1e-15);                            // the poles: no slip
+  CHECK_THROWS_AS(squirmer_slip(B1, B2, Vec<3>(1, 1, 0)), InvalidArgument);
+  CHECK_THROWS_WITH(squirmer_slip(B1, B2, Vec<3>(1, 1, 0)), Catch::Contains("unit vector"));
+}
+
 TEST_CASE("massless squirmer sphere (paper 6.1): V = -<u_s> and w = -3 / (8 R) e x Q, force- and torque-free",
           "[bodies3d][squirmer]") {
   // sphere R = 0.25 in the cube [-2.5, 2.5]^3 (10 R to each wall; h = R / 2.5 on the sphere,

@@ -12,7 +12,10 @@
 //          --pairs P2P1,P1P1GLS   (default both)
 //          --solvers a,b,..  (default krylov,krylov-mass,umfpack): krylov (SaddlePointGmres<3>,
 //                   algebraic Schur), krylov-mass (with saddle_point_blocks: pressure mass,
-//                   Cahouet–Chabard when --mass > 0), umfpack (UmfPackLu symmetric), sparselu
+//                   Cahouet–Chabard when --mass > 0), krylov-ns and krylov-mass-ns (the same on
+//                   the cavity assembled without the pin, the constant pressure as the
+//                   solver's null space, as a closed-domain flow hands it; compared with the
+//                   pinned direct solution on the pinned system's unknowns), umfpack (UmfPackLu symmetric), sparselu
 //                   (SparseLu<>), bicgstab (BiCgStabIlut, tolerance --tol, 2000 iterations);
 //                   with PETSc (built against alefsi::petsc): petsc (PetscKrylov<3>: GMRES +
 //                   fieldsplit Schur, BoomerAMG, selfp), petsc-mass (with the blocks: the
@@ -281,6 +284,29 @@ void bench(const Options& o, const char* pair) {
       k.set_blocks(s.blocks);
       const Row r = run(s, k, x);
       print(o.mass > 0 ? "GMRES + AMG, mass + Cahouet–Chabard" : "GMRES + AMG, pressure mass", r, x);
+    }
+    if (has(o.solvers, "krylov-ns") || has(o.solvers, "krylov-mass-ns")) {
+      // unpinned: the same unknowns with pressure DOF 0 (the first pressure) kept
+      const System u = cavity3d<Pair>(n, o.mass, 1, 0, false);
+      auto as_pinned = [&](const VecX& y) {
+        VecX v(rows);
+        v.head(nu) = y.head(nu);
+        v.tail(rows - nu) = y.tail(rows - nu);  // pressures 1.. and the (no) extras
+        return v;
+      };
+      for (const char* name : {"krylov-ns", "krylov-mass-ns"}) {
+        if (!has(o.solvers, name)) continue;
+        const bool mass = std::string(name) == "krylov-mass-ns";
+        SaddlePointGmres<3> k(o.krylov);
+        k.set_pressure_null_space(true);
+        if (mass) k.set_blocks(u.blocks);
+        VecX y;
+        const Row r = run(u, k, y);
+        x = as_pinned(y);
+        print(!mass ? "GMRES + AMG, lumped Schur, null space"
+                    : (o.mass > 0 ? "GMRES + AMG, mass + Cahouet–Chabard, null space" : "GMRES + AMG, pressure mass, null space"),
+              r, x);
+      }
     }
 #ifdef ALEFSI_HAVE_PETSC
     const std::string ranks = " (" + std::to_string(PetscSession::size()) + " rank" + (PetscSession::size() > 1 ? "s)" : ")");

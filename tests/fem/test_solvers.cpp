@@ -404,11 +404,72 @@ TEST_CASE("SaddlePointGmres solves 3D Stokes (P2/P1, P1/P1-GLS) and agrees with 
   }
   // bad input
   CHECK_THROWS_AS(SaddlePointGmres<3>(KrylovOptions{.tolerance = 0}), InvalidArgument);
+  SaddlePointGmres<3> one_pressure;
+  one_pressure.set_pressure_null_space(true);
+  SparseMatrix tiny(2, 2);  // [1 1; 1 0]: one velocity, one pressure
+  tiny.insert(0, 0) = 1, tiny.insert(0, 1) = 1, tiny.insert(1, 0) = 1;
+  CHECK_THROWS_WITH(one_pressure.analyze(tiny), Catch::Contains("too few for a pressure null space"));
   CHECK_THROWS_WITH(SaddlePointGmres<3>(KrylovOptions{.augment = -1}), Catch::Contains("augment"));
   SaddlePointGmres<3> k;
   SparseMatrix spd(2, 2);
   spd.insert(0, 0) = 1, spd.insert(1, 1) = 2;
   CHECK_THROWS_AS(k.analyze(spd), SolverError);  // no saddle point: nothing to call pressure
+}
+
+TEST_CASE("SaddlePointGmres takes a closed domain's system unpinned: the constant pressure is its null space",
+          "[la][solvers][krylov][quick]") {
+  // The cavity (every boundary velocity given) assembled with and without the pin of pressure
+  // DOF 0. Unpinned, K [0; 1] = 0 exactly (Bt 1 = 0, the GLS terms act on grad q); the solver
+  // returns the pinned system's solution up to the constant, with zero pressure sum, in fewer
+  // iterations (the pin's near-null vector, the constant on the free pressures, is gone).
+  KrylovOptions opt;
+  opt.tolerance = 1e-10;
+  for (int pair = 0; pair < 2; ++pair) {
+    const auto pinned = pair == 0 ? cavity3d<TaylorHood>(6) : cavity3d<P1P1Gls>(8);
+    const auto open = pair == 0 ? cavity3d<TaylorHood>(6, 0, 1, 0, false) : cavity3d<P1P1Gls>(8, 0, 1, 0, false);
+    const Index n = pinned.A.rows(), np = open.blocks.n_pressure, nu = open.A.rows() - np;
+    REQUIRE(open.A.rows() == n + 1);
+    REQUIRE(np == pinned.blocks.n_pressure + 1);
+    VecX e = VecX::Zero(n + 1);
+    e.segment(nu, np).setOnes();
+    CHECK((open.A * e).norm() <= 1e-12 * open.A.norm());
+    CHECK((open.A.transpose() * e).norm() <= 1e-12 * open.A.norm());
+    const VecX reference = solve_with<SparseLu<>>(pinned.A, pinned.b);
+    for (bool blocks : {false, true}) {
+      CAPTURE(pair, blocks);
+      SaddlePointGmres<3> with_pin(opt), with_null(opt);
+      with_null.set_pressure_null_space(true);
+      if (blocks) with_pin.set_blocks(pinned.blocks), with_null.set_blocks(open.blocks);
+      with_pin.analyze(pinned.A), with_pin.factorize(pinned.A);
+      with_null.analyze(open.A), with_null.factorize(open.A);
+      with_pin.solve(pinned.b);
+      const VecX x = with_null.solve(open.b);
+      CHECK(relative_residual(open.A, x, open.b) <= opt.tolerance);
+      CHECK(with_null.pressure_defect() <= 1e-14);  // the cavity's data conserve mass
+      CHECK(std::abs(x.segment(nu, np).sum()) <= 1e-12 * x.segment(nu, np).norm());
+      // velocities alike; pressures alike up to a constant (on DOFs 1.., the pinned unknowns)
+      CHECK((x.head(nu) - reference.head(nu)).norm() <= 1e-8 * reference.head(nu).norm());
+      VecX p = x.tail(n - nu), p_ref = reference.tail(n - nu);
+      p.array() -= p.mean(), p_ref.array() -= p_ref.mean();
+      CHECK((p - p_ref).norm() <= 1e-7 * p_ref.norm());  // tolerance x cond(K on range(K)), ~1e2 here
+      INFO("iterations: pinned " << with_pin.iterations() << ", null space " << with_null.iterations());
+      CHECK(with_null.iterations() < with_pin.iterations());
+      // a b along e (data that do not conserve mass): taken off and reported, x unchanged
+      const Real c = 1e-3 * open.b.norm() / std::sqrt(Real(np));
+      const VecX x_defect = with_null.solve(open.b + c * e);
+      CHECK(with_null.pressure_defect() == Approx(c * std::sqrt(Real(np)) / (open.b + c * e).norm()).epsilon(1e-6));
+      CHECK((x_defect - x).norm() <= 1e-8 * x.norm());
+    }
+  }
+  // Stokes::solve hands it the system unpinned too: the same field as the pinned direct solve
+  const Mesh<3> mesh = box_mesh(4, 4, 4);
+  Stokes<3, TaylorHood> stokes(mesh, 1.0, [](const Vec<3>& x) { return Vec<3>(0, x[2], x[0] * x[1]); });
+  for (Index f : mesh.boundary_facets())
+    stokes.set_velocity(mesh.facet_tag(f), [](const Vec<3>& x) { return Vec<3>(x[1], x[2], 0); });
+  const VecX direct = stokes.solve();
+  const VecX krylov = stokes.solve(SaddlePointGmres<3>({.tolerance = 1e-11}));
+  CHECK(stokes.pressure_pinned());
+  CHECK((krylov - direct).norm() <= 1e-8 * direct.norm());
 }
 
 TEST_CASE("SaddlePointGmres keeps its set-up for later matrices of the same pattern (LinearSolve)",
@@ -560,13 +621,34 @@ TEST_CASE("gmres with augment (LGMRES): the corrections keep what a short restar
   CHECK(x0 == x1);
 }
 
-TEST_CASE("SaddlePointGmres on a graded mesh with a free sphere: LGMRES converges where GMRES(60) stagnates, and "
-          "agrees with unrestarted GMRES",
+namespace {
+
+// SaddlePointGmres without `set_pressure_null_space`: a flow pins pressure DOF 0 for it, as it
+// does for a direct solver (what the library did before the null space)
+struct PinnedSaddlePointGmres {
+  static constexpr const char* name = "GMRES+block(AMG, Schur), pinned";
+  SaddlePointGmres<3> s;
+  explicit PinnedSaddlePointGmres(KrylovOptions o = {}) : s(o) {}
+  void set_blocks(SaddlePointBlocks b) { s.set_blocks(std::move(b)); }
+  void analyze(const SparseMatrix& A) { s.analyze(A); }
+  void factorize(const SparseMatrix& A) { s.factorize(A); }
+  VecX solve(const VecX& b) { return s.solve(b); }
+  VecX solve(const SparseMatrix& A, const VecX& b) { return s.solve(A, b); }
+  int iterations() const { return s.iterations(); }
+  Real residual() const { return s.residual(); }
+};
+
+}  // namespace
+
+TEST_CASE("SaddlePointGmres on a graded mesh with a free sphere: with the pin GMRES(60) stagnates; with the "
+          "null space it converges, restarted or not, to the same answer",
           "[la][solvers][krylov][bodies3d][quick]") {
   // A free sphere (radius 1/4) pushed by a unit force inside a fixed concentric sphere (radius 2),
   // Stokes, Taylor–Hood. The shell mesh's layers are pulled towards the body, r = r1 + (r2 - r1) t^5
   // (cells from about 0.01 at the body to 0.26 outside): the small version of a graded gmsh mesh
-  // on which GMRES(60) stopped at 1000 iterations (docs/solvers.md, "Graded meshes and restarts").
+  // on which GMRES(60) stopped at 1000 iterations (docs/solvers.md, "A closed domain: the
+  // pressure's null space"). The domain is closed: a pin of pressure DOF 0 leaves K a near-null
+  // vector, which the restarts lose and find again; the unpinned system has none.
   const Real r1 = 0.25, r2 = 2.0;
   Mesh<3> mesh = spherical_shell_mesh(r1, r2, 3);
   std::vector<Vec<3>> x = mesh.coordinates();
@@ -575,10 +657,14 @@ TEST_CASE("SaddlePointGmres on a graded mesh with a free sphere: LGMRES converge
     p *= (r1 + (r2 - r1) * std::pow(t, 5)) / r;
   }
   mesh.set_coordinates(std::move(x));
-  using Flow = AleFlow<FlowConfig<3, TaylorHood, BSS, UnsteadyStokes, SaddlePointGmres<3>>>;
-  auto solve = [&](KrylovOptions opt) {
+  auto solve = [&]<class Solver>(KrylovOptions opt) {
+    using Flow = AleFlow<FlowConfig<3, TaylorHood, BSS, UnsteadyStokes, Solver>>;
     constexpr FlowOptions stokes{.rho = 1e-12, .mu = 1, .linearisation = Linearisation::semi_implicit};
-    auto flow = std::make_unique<Flow>(mesh, stokes, opt);
+    std::unique_ptr<Flow> flow;
+    if constexpr (DirectSolver<Solver>)
+      flow = std::make_unique<Flow>(mesh, stokes);
+    else
+      flow = std::make_unique<Flow>(mesh, stokes, opt);
     flow->set_velocity(tags::outer, [](const Vec<3>&, Real) { return Vec<3>(0, 0, 0); });
     flow->set_prescribed_mesh_velocity([](const Vec<3>&, Real) { return Vec<3>(0, 0, 0); });
     RigidBody3D body = sphere_body(tags::inner, Vec<3>::Zero(), r1, 1.0);
@@ -587,22 +673,46 @@ TEST_CASE("SaddlePointGmres on a graded mesh with a free sphere: LGMRES converge
     flow->step(1.0);
     return flow;
   };
-  // plain restarted GMRES: the residual falls by a constant factor per cycle, short of 1e-8
+  // pinned, plain restarted GMRES: the residual falls by a constant factor per cycle, short of 1e-8
   try {
-    solve({.augment = 0});
-    FAIL("GMRES(60) was expected to stop short on this mesh");
+    solve.operator()<PinnedSaddlePointGmres>({.augment = 0});
+    FAIL("GMRES(60) with the pin was expected to stop short on this mesh");
   } catch (const SolverError& e) {
     const std::string what = e.what();
     CHECK(what.find("1000 iterations") != std::string::npos);
     CHECK(what.find("e-0") != std::string::npos);  // the residual in scientific notation
   }
-  const auto lgmres = solve({});                             // LGMRES(60, 2), the default
-  const auto full = solve({.restart = 1000, .augment = 0});  // no restart: the fewest iterations
-  INFO("LGMRES(60,2) " << lgmres->solver().iterations() << " iterations, GMRES without restarts "
-                       << full->solver().iterations());
-  CHECK(lgmres->solver().residual() <= 1e-8);
-  const Vec<6> z = lgmres->body_velocity(0), z_full = full->body_velocity(0);
-  CHECK((z - z_full).norm() <= 1e-6 * z_full.norm());
-  CHECK((lgmres->field() - full->field()).norm() <= 1e-6 * full->field().norm());
-  CHECK(z[2] < 0);  // the sphere moves with the force
+  const auto direct = solve.operator()<SparseLu<>>({});  // the reference (pinned; exact to round-off)
+  const auto pinned = solve.operator()<PinnedSaddlePointGmres>({.restart = 1000, .augment = 0});
+  const auto gmres60 = solve.operator()<SaddlePointGmres<3>>({.augment = 0});
+  const auto lgmres = solve.operator()<SaddlePointGmres<3>>({});  // LGMRES(60, 2), the default
+  const auto full = solve.operator()<SaddlePointGmres<3>>({.restart = 1000, .augment = 0});
+  CHECK(!pinned->pressure_null_space());
+  CHECK(full->pressure_null_space());
+  INFO("null space: GMRES(60) " << gmres60->solver().iterations() << ", LGMRES(60,2) "
+                                << lgmres->solver().iterations() << ", GMRES without restarts "
+                                << full->solver().iterations() << " iterations; pinned, without restarts "
+                                << pinned->solver().iterations());
+  CHECK(full->solver().iterations() < pinned->solver().iterations());
+  // errors against the direct solve (both shifted to zero mean pressure): velocity, pressure
+  const Index nv = direct->space().pressure_field(0);  // velocities first, then pressures
+  const VecX& ref = direct->field();
+  auto error = [&](const auto& f) {
+    const VecX d = f->field() - ref;
+    return std::pair{d.head(nv).norm() / ref.head(nv).norm(), d.tail(d.size() - nv).norm() / ref.tail(d.size() - nv).norm()};
+  };
+  const auto [u_pin, p_pin] = error(pinned);
+  INFO("pinned GMRES: velocity error " << u_pin << ", pressure error " << p_pin);
+  for (const auto* f : {gmres60.get(), lgmres.get(), full.get()}) {
+    const auto [u_err, p_err] = error(f);
+    INFO("null space: velocity error " << u_err << ", pressure error " << p_err);
+    CHECK(f->solver().residual() <= 1e-8);
+    CHECK((f->body_velocity(0) - direct->body_velocity(0)).norm() <= 1e-6 * direct->body_velocity(0).norm());
+    CHECK(u_err <= 1e-6);
+    CHECK(p_err <= 1e-6);
+    // the pinned solve's error along its near-null vector (the constant on all pressures but
+    // DOF 0) is left at DOF 0 after the shift to zero mean
+    CHECK(p_err < p_pin);
+  }
+  CHECK(full->body_velocity(0)[2] < 0);  // the sphere moves with the force
 }

@@ -53,11 +53,12 @@ inline void add_velocity_mass(const MixedSpace<3, Pair>& space, const DofConstra
 }
 
 // 3D lid-driven cavity on box_mesh(n, n, n): every boundary velocity fixed (lid z = 1:
-// (1, 0, 0)), pressure DOF 0 pinned, mu = 1; b = -r at the zero field. gamma > 0 adds gamma M_u
-// to the velocity block (the rho a0 / dt part of a time step) and hands it to the blocks.
-// parts > 1 (gamma 0): also the matrix of the cells of Morton part `part` of `parts`.
+// (1, 0, 0)), pressure DOF 0 pinned (pin = false: not, the constant pressure is then K's null
+// space), mu = 1; b = -r at the zero field. gamma > 0 adds gamma M_u to the velocity block (the
+// rho a0 / dt part of a time step) and hands it to the blocks. parts > 1 (gamma 0): also the
+// matrix of the cells of Morton part `part` of `parts`.
 template <class Pair>
-inline SaddleSystem cavity3d(int n, Real gamma = 0, int parts = 1, int part = 0) {
+inline SaddleSystem cavity3d(int n, Real gamma = 0, int parts = 1, int part = 0, bool pin = true) {
   const Mesh<3> mesh = box_mesh(n, n, n);
   MixedSpace<3, Pair> space(mesh);
   StokesKernel<3, Pair> kernel(space, 1.0);
@@ -70,7 +71,7 @@ inline SaddleSystem cavity3d(int n, Real gamma = 0, int parts = 1, int part = 0)
       done[i] = 1;
       for (int k = 0; k < 3; ++k) cons.fix(space.velocity_field(i, k), (t == tags::zmax && k == 0) ? 1.0 : 0.0);
     }
-  cons.fix(space.pressure_field(0), 0.0);
+  if (pin) cons.fix(space.pressure_field(0), 0.0);
   cons.finalize();
   Assembler<MixedSpace<3, Pair>::n_local> asmb(mesh.n_cells(), [&](Index c) { return space.cell_field_dofs(c); }, cons);
   SaddleSystem s;

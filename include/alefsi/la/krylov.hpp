@@ -32,6 +32,23 @@
 ///         matrix: the contiguous range of unknowns whose diagonal entry is <= 0 (zero for
 ///         Taylor–Hood, -C_ii < 0 for GLS; every velocity and body diagonal is > 0).
 ///
+/// A closed domain (every boundary velocity given) defines the pressure up to a constant. The
+/// direct solvers need it pinned (one pressure DOF fixed), but a pin leaves K a near-null vector:
+/// the constant on the free pressures, with K v = the pinned DOF's column of Bt, of the size of
+/// one basis function's. GMRES resolves that mode slowly and, at 1e-8, sometimes not at all (ten
+/// Cate's E1 at D / 12 stagnated at 1.1-1.8e-8 after 1000 iterations with |x| = 221 for
+/// |b| = 1.4e-10; docs/solvers.md). So this solver takes the system unpinned
+/// (`set_pressure_null_space(true)`, as `Discretisation` does for a closed domain): then K's
+/// null space, and K^T's, is exactly e = [0; 1; 0], the constant on all pressures (Bt 1 = 0 for
+/// a velocity that vanishes or moves rigidly on the whole boundary, and GLS terms act on grad q).
+/// `solve` takes b's component along e off (a consistent b has none: it is round-off, or a
+/// mass defect of the boundary data, reported as `pressure_defect`), iterates, and returns the
+/// x whose pressures have zero sum. GMRES converges on such a singular system: its Krylov space
+/// lies in range(K), and P e is not in range(K) (Brown & Walker, SIAM J. Matrix Anal. Appl. 18
+/// (1997) 37). The Cahouet–Chabard Laplacian L has the constant as its null space too: its
+/// V-cycle is built on L without the first pressure (a pin inside the preconditioner only) and
+/// applied to r_p with its mean removed, which solves L p = r_p on the complement of the constant.
+///
 /// `analyze(A)` finds the block split (once per pattern); `factorize(A)` builds the AMG
 /// hierarchies and Schur approximations (values are read: per matrix); `solve(b)` iterates until
 /// ||b - K x|| <= tolerance ||b|| and throws `SolverError` when `max_iterations` are spent.
@@ -94,6 +111,14 @@ class SaddlePointGmres {
     analyzed_ = false;
   }
 
+  /// Whether K is unpinned with the constant pressure as its null space (file comment). Takes
+  /// effect at the next `analyze`/`factorize`.
+  void set_pressure_null_space(bool on) {
+    null_space_ = on;
+    analyzed_ = false;
+  }
+  bool pressure_null_space() const { return null_space_; }
+
   /// Finds the split [u | p | z] (from the blocks, or from the diagonal's sign).
   void analyze(const SparseMatrix& A) {
     n_ = A.rows();
@@ -110,6 +135,7 @@ class SaddlePointGmres {
       if (nu_ % D == 0)
         for (Index i = 0; i < nu_; ++i) comp_[i] = int(i % D);
     }
+    ALEFSI_CHECK_ARG(!null_space_ || np_ >= 2, "A", "has ", np_, " pressure unknowns: too few for a pressure null space");
     analyzed_ = true;
   }
 
@@ -166,6 +192,7 @@ class SaddlePointGmres {
         const RowSparseMatrix Bu = Bp.leftCols(nu_);
         const RowSparseMatrix Bt = Ar.block(0, p0, nu_, np_);
         RowSparseMatrix L = Bu * inv_m.asDiagonal() * Bt;
+        if (null_space_) L = RowSparseMatrix(L.bottomRightCorner(np_ - 1, np_ - 1));  // L 1 = 0: pinned here
         laplace_amg_.compute(std::move(L));
       }
     } else {
@@ -208,12 +235,32 @@ class SaddlePointGmres {
   VecX solve(const VecX& b) {
     if (!A_) throw SolverError(std::string(name) + ": solve before factorize");
     ALEFSI_CHECK_ARG(b.size() == n_, "b", "has ", b.size(), " entries, expected ", n_);
+    const GmresOptions gopt{.tolerance = opt_.tolerance, .max_iterations = opt_.max_iterations,
+                            .restart = opt_.restart, .augment = opt_.augment};
+    auto prec = [this](const VecX& v) { return precondition(v); };
     VecX x;
-    const GmresResult res = gmres(
-        *A_, b, [this](const VecX& v) { return precondition(v); },
-        {.tolerance = opt_.tolerance, .max_iterations = opt_.max_iterations, .restart = opt_.restart,
-         .augment = opt_.augment},
-        x, work_);
+    GmresResult res;
+    defect_ = 0;
+    if (!null_space_) {
+      res = gmres(*A_, b, prec, gopt, x, work_);
+    } else {
+      // b without its component along e; the tolerance stays relative to ||b||
+      VecX bc = b;
+      const Real mean = bc.segment(nu_, np_).mean();
+      bc.segment(nu_, np_).array() -= mean;
+      const Real bn = b.norm(), cn = bc.norm();
+      defect_ = bn > 0 ? std::abs(mean) * std::sqrt(Real(np_)) / bn : 0;
+      if (cn <= opt_.tolerance * bn) {
+        x = VecX::Zero(n_);
+        res.converged = true;
+      } else {
+        GmresOptions copt = gopt;
+        copt.tolerance = opt_.tolerance * bn / cn;
+        res = gmres(*A_, bc, prec, copt, x, work_);
+        res.residual *= cn / bn;
+      }
+      x.segment(nu_, np_).array() -= x.segment(nu_, np_).mean();
+    }
     iterations_ = res.iterations, residual_ = res.residual;
     if (!res.converged)
       throw SolverError(std::string(name) + " did not converge: " + std::to_string(res.iterations) +
@@ -231,7 +278,14 @@ class SaddlePointGmres {
     VecX p;
     if (use_mass_) {
       p = has_c_ ? mass_amg_.apply(rp) : VecX(mass_solve(rp) / mass_scale_);
-      if (use_laplace_) p += laplace_amg_.apply(rp);
+      if (use_laplace_) {
+        if (!null_space_) {
+          p += laplace_amg_.apply(rp);
+        } else {  // L p = r_p - mean(r_p) with p's first entry 0 (file comment)
+          const VecX q = rp.tail(np_ - 1).array() - rp.mean();
+          p.tail(np_ - 1) += laplace_amg_.apply(q);
+        }
+      }
     } else {
       p = has_c_ ? mass_amg_.apply(rp) : VecX(schur_inv_diag_.cwiseProduct(rp));
     }
@@ -249,9 +303,13 @@ class SaddlePointGmres {
     return z;
   }
 
-  /// GMRES iterations and final relative residual of the last solve.
+  /// GMRES iterations and final relative residual ||b - K x|| / ||b|| of the last solve (with a
+  /// pressure null space: of b without its defect).
   int iterations() const { return iterations_; }
   Real residual() const { return residual_; }
+  /// With a pressure null space: |b . e| / (|e| ||b||) of the last solve, the part of b that no x
+  /// reaches (round-off for a consistent system).
+  Real pressure_defect() const { return defect_; }
   Index n_velocity() const { return nu_; }
   Index n_pressure() const { return np_; }
   Index n_extra() const { return ne_; }
@@ -289,7 +347,7 @@ class SaddlePointGmres {
 
   KrylovOptions opt_;
   std::optional<SaddlePointBlocks> blocks_;
-  bool analyzed_ = false, use_mass_ = false, use_laplace_ = false, has_c_ = false;
+  bool analyzed_ = false, null_space_ = false, use_mass_ = false, use_laplace_ = false, has_c_ = false;
   Index n_ = 0, nu_ = 0, np_ = 0, ne_ = 0;
   std::vector<int> comp_;
   const SparseMatrix* A_ = nullptr;
@@ -301,7 +359,7 @@ class SaddlePointGmres {
   Real cheb_lo_ = 0.5, cheb_hi_ = 2.5, mass_scale_ = 1;
   GmresWork work_;
   int iterations_ = 0;
-  Real residual_ = 0;
+  Real residual_ = 0, defect_ = 0;
 };
 
 static_assert(LinearSolver<SaddlePointGmres<3>>, "SaddlePointGmres must model LinearSolver");

@@ -22,6 +22,12 @@
 
 namespace alefsi {
 
+/// A solver that can take a closed domain's system unpinned, with the constant pressure as its
+/// null space (SaddlePointGmres, la/krylov.hpp, whose file comment says why: a pin would leave
+/// it a near-null vector). The flows (sim/discretisation.hpp) and `Stokes` then pin nothing.
+template <class S>
+concept SolvesPressureNullSpace = requires(S s) { s.set_pressure_null_space(true); };
+
 /// What the space knows about a flow system's unknowns [u | p | z] (see the file comment).
 struct SaddlePointBlocks {
   Index n_pressure = 0;                 ///< free pressure unknowns, after the velocity ones

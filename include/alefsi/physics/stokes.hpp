@@ -14,8 +14,9 @@
 /// The residual form r(u) = A u - F is assembled at the current field (Dirichlet values
 /// included through `DofConstraints` offsets); one Newton step from any state solves the
 /// linear problem. When every boundary facet carries a Dirichlet condition the pressure is
-/// defined up to a constant: pressure DOF 0 is pinned to 0 during the solve and the computed
-/// pressure is then shifted to zero mean over the domain.
+/// defined up to a constant: pressure DOF 0 is pinned to 0 during the solve (a solver that takes
+/// the constant as its null space, SolvesPressureNullSpace, gets the system unpinned) and the
+/// computed pressure is then shifted to zero mean over the domain.
 ///
 ///     alefsi::Stokes<2, alefsi::TaylorHood> stokes(mesh, /*mu=*/1.0, f);
 ///     for (int t : {1, 2, 3, 4}) stokes.set_velocity(t, u_exact);
@@ -32,6 +33,7 @@
 #include "alefsi/fem/geometry.hpp"
 #include "alefsi/fem/quadrature.hpp"
 #include "alefsi/la/assembler.hpp"
+#include "alefsi/la/saddle_point_blocks.hpp"
 #include "alefsi/la/solvers.hpp"
 #include "alefsi/physics/affine_forms.hpp"
 #include "alefsi/physics/stabilisation.hpp"
@@ -262,7 +264,9 @@ class Stokes {
 
   const Space& space() const { return space_; }
   const Kernel& kernel() const { return kernel_; }
-  /// True when the pressure was fixed by pinning (all boundary velocities prescribed).
+  /// True when every boundary velocity is prescribed, so that the pressure is defined up to a
+  /// constant: pressure DOF 0 was pinned (or, for a SolvesPressureNullSpace solver, the
+  /// constant was its null space) and the pressure shifted to zero mean.
   bool pressure_pinned() const { return pinned_; }
 
   /// Assembles and solves; returns the field vector (velocity interleaved, then pressure).
@@ -276,7 +280,12 @@ class Stokes {
       for (int k = 0; k < D; ++k) cons.set_fixed_value(space_.velocity_field(i, k), val[k]);
     }
     pinned_ = whole_boundary_prescribed(space_.mesh(), [&](int tag) { return dirichlet_.count(tag) > 0; });
-    if (pinned_) cons.fix(space_.pressure_field(0), 0.0);
+    bool null_space = false;  // the solver takes the constant pressure as its null space instead
+    if constexpr (SolvesPressureNullSpace<Solver>) {
+      null_space = pinned_;
+      solver.set_pressure_null_space(null_space);
+    }
+    if (pinned_ && !null_space) cons.fix(space_.pressure_field(0), 0.0);
     cons.finalize();
     Assembler<Space::n_local> asmb(space_.mesh().n_cells(), [&](Index c) { return space_.cell_field_dofs(c); }, cons);
     VecX field = cons.expand(VecX::Zero(cons.n_unknowns()));

@@ -14,7 +14,8 @@
 ///   4. the flow at n+theta on X^{n+theta} (physics/navier_stokes.hpp) with the bodies' rows
 ///      and the contact forces: Newton (sim/newton.hpp) with the exact Jacobian, or one
 ///      semi-implicit solve. Dirichlet velocities (`set_velocity`) are imposed at t^{n+1} on
-///      X^{n+1}; when every boundary velocity is prescribed, pressure DOF 0 is pinned and the
+///      X^{n+1}; when every boundary velocity is prescribed, pressure DOF 0 is pinned (or, for
+///      a solver that takes it, the constant pressure is the system's null space) and the
 ///      pressure shifted to zero mean;
 ///   5. the new level enters the state (sim/flow_state.hpp); then, if the remesher asks for
 ///      it, the mesh is adapted and the state transferred (sim/remesher.hpp).
@@ -120,6 +121,13 @@ class AleFlow {
   const Space& space() const { return disc_.space(); }
   /// The flow system's linear solver (its analysis is redone after every topology change).
   Solver& solver() { return disc_.linear_solve().solver(); }
+  const Solver& solver() const { return disc_.linear_solve().solver(); }
+  /// Every boundary velocity is prescribed: the pressure is defined up to a constant (and
+  /// reported with zero mean).
+  bool closed_domain() const { return disc_.closed_domain(); }
+  /// ... and the solver takes the system unpinned, the constant pressure as its null space
+  /// (SolvesPressureNullSpace, sim/discretisation.hpp) rather than pressure DOF 0 pinned.
+  bool pressure_null_space() const { return disc_.pressure_null_space(); }
   const State& state() const { return state_; }
   const FlowStats& stats() const { return state_.stats; }
   /// Whether a change of dt keeps the history (FlowOptions::variable_steps).
@@ -472,7 +480,7 @@ class AleFlow {
     }
     // a closed domain needs each slip discretely flux-free on this mesh (on flat facets: curved
     // cells carry their slip as given)
-    bodies_.remove_slip_flux(state_.bodies, Space::VelocityElement::degree, disc_.pressure_pinned() && !geometry_);
+    bodies_.remove_slip_flux(state_.bodies, Space::VelocityElement::degree, disc_.closed_domain() && !geometry_);
     bodies_.check_radii(mesh_, state_.bodies);
     bodies_.check_shapes(state_.bodies);
     if (state_.stats.steps == 0) bodies_.check_slip(mesh_, state_.bodies);
@@ -513,7 +521,7 @@ class AleFlow {
       const VecX u = solve_flow(c, t1, g, Xth, rep);
       VecX field = disc_.constraints().expand(u);
       bodies_.driven_loads(s.bodies, space(), disc_.kernel(), field, c, Xth);
-      if (disc_.pressure_pinned()) shift_pressure_to_zero_mean(space(), field);
+      if (disc_.closed_domain()) shift_pressure_to_zero_mean(space(), field);
       if (control) {
         rep.error = estimate_error(c.dt, field, u, t1);
         if (const Real e = rep.error.scaled(*control); e > 1)

@@ -87,7 +87,8 @@ class Discretisation {
 
   /// The constraints of the flow system: velocity DOFs on the tags of `dirichlet` (a map
   /// keyed by tag) fixed, the bodies' surface DOFs fixed or linked (BodySystem::constrain),
-  /// pressure DOF 0 pinned when every boundary velocity is prescribed; then the pattern.
+  /// pressure DOF 0 pinned when every boundary velocity is prescribed (unless the solver takes
+  /// the constant pressure as a null space instead: `pressure_null_space()`); then the pattern.
   template <class Dirichlet, class Bodies>
   void constrain(const Dirichlet& dirichlet, Bodies& bodies) {
     cons_ = std::make_unique<DofConstraints>(space_->n_field());
@@ -95,10 +96,23 @@ class Discretisation {
     dirichlet_dofs_ = fix_velocity_on_tags(*space_, dirichlet, *cons_, taken);
     bodies.constrain(*space_, *cons_, taken);
     // every boundary velocity prescribed (walls or bodies): p is defined up to a constant
-    pinned_ = whole_boundary_prescribed(space_->mesh(),
+    closed_ = whole_boundary_prescribed(space_->mesh(),
                                         [&](int tag) { return bodies.has_tag(tag) || dirichlet.count(tag) > 0; });
-    if (pinned_) cons_->fix(space_->pressure_field(0), 0.0);
+    null_space_ = false;
+    if constexpr (SolvesPressureNullSpace<Solver>) {
+      null_space_ = closed_;
+      solve_.solver().set_pressure_null_space(null_space_);
+    }
+    if (closed_ && !null_space_) cons_->fix(space_->pressure_field(0), 0.0);
     cons_->finalize();
+    p_first_ = p_count_ = 0;
+    if (null_space_) {  // the pressure unknowns: all free, contiguous after the velocities
+      p_first_ = cons_->indices(space_->pressure_field(0))[0];
+      p_count_ = space_->pressure().n_dofs();
+      for (Index k = 0; k < p_count_; ++k)
+        ALEFSI_ASSERT(cons_->kind(space_->pressure_field(k)) == DofConstraints::Kind::free &&
+                      cons_->indices(space_->pressure_field(k))[0] == p_first_ + k);
+    }
     in_parts_ = false;
     if constexpr (SummedPartsSolver<Solver>) {
       Solver& s = solve_.solver();
@@ -130,9 +144,15 @@ class Discretisation {
   bool constrained() const { return cons_ != nullptr; }
 
   /// The Jacobian (of this process's cells, in parts) into J and the residual (whole) into r, at
-  /// `field`; either may be null.
+  /// `field`; either may be null. With a pressure null space the residual's continuity rows
+  /// lose their sum: the mass defect of the boundary data (round-off when they conserve mass),
+  /// which no update reaches and which a pin would put into one pressure DOF's cell.
   void assemble(const VecX& field, SparseMatrix* J, VecX* r) {
-    if (!in_parts_) return asmb_->assemble(*kernel_, field, J, r);
+    if (!in_parts_) {
+      asmb_->assemble(*kernel_, field, J, r);
+      if (r && null_space_) r->segment(p_first_, p_count_).array() -= r->segment(p_first_, p_count_).mean();
+      return;
+    }
     asmb_->assemble(PartKernel<Kernel>{kernel_.get(), &own_cells_}, field, J, r);
     if (r) sum_parts(*r);
   }
@@ -223,8 +243,11 @@ class Discretisation {
   const LinearSolve<Solver>& linear_solve() const { return solve_; }
   /// (scalar velocity DOF, tag) of the Dirichlet DOFs.
   const std::vector<std::pair<Index, int>>& dirichlet_dofs() const { return dirichlet_dofs_; }
-  /// Pressure DOF 0 is pinned (the pressure is shifted to zero mean after each solve).
-  bool pressure_pinned() const { return pinned_; }
+  /// Every boundary velocity is prescribed: the pressure is defined up to a constant (pressure
+  /// DOF 0 pinned, or the solver's null space), shifted to zero mean after each solve.
+  bool closed_domain() const { return closed_; }
+  /// The solver takes the closed domain's system unpinned (SolvesPressureNullSpace).
+  bool pressure_null_space() const { return null_space_; }
 
  private:
   FlowOptions opt_;
@@ -236,7 +259,8 @@ class Discretisation {
   SparseMatrix J_;
   LinearSolve<Solver> solve_;
   std::vector<std::pair<Index, int>> dirichlet_dofs_;
-  bool pinned_ = false;
+  bool closed_ = false, null_space_ = false;
+  Index p_first_ = 0, p_count_ = 0;  // with a null space: the pressure unknowns
   Real gamma_ = -1;
   VecX hist_, ustar_;  // the step's kernel inputs
   const QuadraticGeometry<D>* geometry_ = nullptr;

@@ -15,8 +15,9 @@
 //                   Cahouet–Chabard when --mass > 0), krylov-ns and krylov-mass-ns (the same on
 //                   the cavity assembled without the pin, the constant pressure as the
 //                   solver's null space, as a closed-domain flow hands it; compared with the
-//                   pinned direct solution on the pinned system's unknowns), umfpack (UmfPackLu symmetric), sparselu
-//                   (SparseLu<>), bicgstab (BiCgStabIlut, tolerance --tol, 2000 iterations);
+//                   pinned direct solution on the pinned system's unknowns), umfpack
+//                   (UmfPackLu symmetric), sparselu (SparseLu<>), bicgstab (BiCgStabIlut,
+//                   tolerance --tol, 2000 iterations);
 //                   with PETSc (built against alefsi::petsc): petsc (PetscKrylov<3>: GMRES +
 //                   fieldsplit Schur, BoomerAMG, selfp), petsc-mass (with the blocks: the
 //                   pressure mass), mumps (PetscDirect). Under `mpirun -n P` pass only these:
@@ -303,9 +304,10 @@ void bench(const Options& o, const char* pair) {
         VecX y;
         const Row r = run(u, k, y);
         x = as_pinned(y);
-        print(!mass ? "GMRES + AMG, lumped Schur, null space"
-                    : (o.mass > 0 ? "GMRES + AMG, mass + Cahouet–Chabard, null space" : "GMRES + AMG, pressure mass, null space"),
-              r, x);
+        const char* label = !mass       ? "GMRES + AMG, lumped Schur, null space"
+                            : o.mass > 0 ? "GMRES + AMG, mass + Cahouet–Chabard, null space"
+                                         : "GMRES + AMG, pressure mass, null space";
+        print(label, r, x);
       }
     }
 #ifdef ALEFSI_HAVE_PETSC

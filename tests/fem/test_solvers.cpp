@@ -699,7 +699,8 @@ TEST_CASE("SaddlePointGmres on a graded mesh with a free sphere: with the pin GM
   const VecX& ref = direct->field();
   auto error = [&](const auto& f) {
     const VecX d = f->field() - ref;
-    return std::pair{d.head(nv).norm() / ref.head(nv).norm(), d.tail(d.size() - nv).norm() / ref.tail(d.size() - nv).norm()};
+    const Index np = d.size() - nv;
+    return std::pair{d.head(nv).norm() / ref.head(nv).norm(), d.tail(np).norm() / ref.tail(np).norm()};
   };
   const auto [u_pin, p_pin] = error(pinned);
   INFO("pinned GMRES: velocity error " << u_pin << ", pressure error " << p_pin);

@@ -135,7 +135,8 @@ class SaddlePointGmres {
       if (nu_ % D == 0)
         for (Index i = 0; i < nu_; ++i) comp_[i] = int(i % D);
     }
-    ALEFSI_CHECK_ARG(!null_space_ || np_ >= 2, "A", "has ", np_, " pressure unknowns: too few for a pressure null space");
+    ALEFSI_CHECK_ARG(!null_space_ || np_ >= 2, "A", "has ", np_,
+                     " pressure unknowns: too few for a pressure null space");
     analyzed_ = true;
   }
 

@@ -28,6 +28,21 @@ namespace alefsi {
 template <class S>
 concept SolvesPressureNullSpace = requires(S s) { s.set_pressure_null_space(true); };
 
+/// The pressure constant of a closed domain (`closed`: every boundary velocity given) in the
+/// constraints `cons` of a system that `solver` will solve: the pressure field DOF `pressure0`
+/// pinned to 0, or, for a SolvesPressureNullSpace solver, nothing pinned and the solver told.
+/// Returns whether the solver takes the null space. Before `cons.finalize()`.
+template <class Solver>
+bool constrain_pressure_constant(Solver& solver, bool closed, DofConstraints& cons, Index pressure0) {
+  bool null_space = false;
+  if constexpr (SolvesPressureNullSpace<Solver>) {
+    null_space = closed;
+    solver.set_pressure_null_space(null_space);
+  }
+  if (closed && !null_space) cons.fix(pressure0, 0.0);
+  return null_space;
+}
+
 /// What the space knows about a flow system's unknowns [u | p | z] (see the file comment).
 struct SaddlePointBlocks {
   Index n_pressure = 0;                 ///< free pressure unknowns, after the velocity ones

@@ -280,12 +280,7 @@ class Stokes {
       for (int k = 0; k < D; ++k) cons.set_fixed_value(space_.velocity_field(i, k), val[k]);
     }
     pinned_ = whole_boundary_prescribed(space_.mesh(), [&](int tag) { return dirichlet_.count(tag) > 0; });
-    bool null_space = false;  // the solver takes the constant pressure as its null space instead
-    if constexpr (SolvesPressureNullSpace<Solver>) {
-      null_space = pinned_;
-      solver.set_pressure_null_space(null_space);
-    }
-    if (pinned_ && !null_space) cons.fix(space_.pressure_field(0), 0.0);
+    constrain_pressure_constant(solver, pinned_, cons, space_.pressure_field(0));
     cons.finalize();
     Assembler<Space::n_local> asmb(space_.mesh().n_cells(), [&](Index c) { return space_.cell_field_dofs(c); }, cons);
     VecX field = cons.expand(VecX::Zero(cons.n_unknowns()));

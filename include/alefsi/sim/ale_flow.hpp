@@ -126,7 +126,7 @@ class AleFlow {
   /// reported with zero mean).
   bool closed_domain() const { return disc_.closed_domain(); }
   /// ... and the solver takes the system unpinned, the constant pressure as its null space
-  /// (SolvesPressureNullSpace, sim/discretisation.hpp) rather than pressure DOF 0 pinned.
+  /// (SolvesPressureNullSpace, la/saddle_point_blocks.hpp) rather than pressure DOF 0 pinned.
   bool pressure_null_space() const { return disc_.pressure_null_space(); }
   const State& state() const { return state_; }
   const FlowStats& stats() const { return state_.stats; }

@@ -271,8 +271,8 @@ class BodySystem {
   /// equations sum to "no net flux through the boundary", which the interpolant of a rigid
   /// velocity meets exactly and that of a slip tangent to the exact surface does not: through
   /// the flat facets it leaks an O(h^2) flux, which a pinned pressure DOF would absorb as a
-  /// point source (and which leaves an unpinned system without a solution). So each body's slip is applied less c n,
-  /// n = r / |r|, c = Phi[u_s] / Phi[n] with Phi the discrete flux through its facets on this
+  /// point source (and which leaves an unpinned system without a solution). So each body's
+  /// slip is applied less c n, n = r / |r|, c = Phi[u_s] / Phi[n] with Phi the discrete flux through its facets on this
   /// mesh (surface_flux, in the body frame of its surface offsets): the same c while the mesh
   /// moves (the surface moves rigidly), recomputed after each remesh. Elsewhere c = 0. Call
   /// after `attach`, with the surface offsets of `states` on this mesh.

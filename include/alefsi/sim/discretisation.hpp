@@ -98,21 +98,12 @@ class Discretisation {
     // every boundary velocity prescribed (walls or bodies): p is defined up to a constant
     closed_ = whole_boundary_prescribed(space_->mesh(),
                                         [&](int tag) { return bodies.has_tag(tag) || dirichlet.count(tag) > 0; });
-    null_space_ = false;
-    if constexpr (SolvesPressureNullSpace<Solver>) {
-      null_space_ = closed_;
-      solve_.solver().set_pressure_null_space(null_space_);
-    }
-    if (closed_ && !null_space_) cons_->fix(space_->pressure_field(0), 0.0);
+    null_space_ = constrain_pressure_constant(solve_.solver(), closed_, *cons_, space_->pressure_field(0));
     cons_->finalize();
-    p_first_ = p_count_ = 0;
-    if (null_space_) {  // the pressure unknowns: all free, contiguous after the velocities
-      p_first_ = cons_->indices(space_->pressure_field(0))[0];
-      p_count_ = space_->pressure().n_dofs();
-      for (Index k = 0; k < p_count_; ++k)
+    if (null_space_)  // the pressure unknowns: all free, contiguous after the velocities
+      for (Index k = 0; k < space_->pressure().n_dofs(); ++k)
         ALEFSI_ASSERT(cons_->kind(space_->pressure_field(k)) == DofConstraints::Kind::free &&
-                      cons_->indices(space_->pressure_field(k))[0] == p_first_ + k);
-    }
+                      cons_->indices(space_->pressure_field(k))[0] == cons_->indices(space_->pressure_field(0))[0] + k);
     in_parts_ = false;
     if constexpr (SummedPartsSolver<Solver>) {
       Solver& s = solve_.solver();
@@ -150,7 +141,10 @@ class Discretisation {
   void assemble(const VecX& field, SparseMatrix* J, VecX* r) {
     if (!in_parts_) {
       asmb_->assemble(*kernel_, field, J, r);
-      if (r && null_space_) r->segment(p_first_, p_count_).array() -= r->segment(p_first_, p_count_).mean();
+      if (r && null_space_) {
+        auto rp = r->segment(cons_->indices(space_->pressure_field(0))[0], space_->pressure().n_dofs());
+        rp.array() -= rp.mean();
+      }
       return;
     }
     asmb_->assemble(PartKernel<Kernel>{kernel_.get(), &own_cells_}, field, J, r);
@@ -260,7 +254,6 @@ class Discretisation {
   LinearSolve<Solver> solve_;
   std::vector<std::pair<Index, int>> dirichlet_dofs_;
   bool closed_ = false, null_space_ = false;
-  Index p_first_ = 0, p_count_ = 0;  // with a null space: the pressure unknowns
   Real gamma_ = -1;
   VecX hist_, ustar_;  // the step's kernel inputs
   const QuadraticGeometry<D>* geometry_ = nullptr;

@@ -5,6 +5,7 @@
 // refused with the flow left as it was.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "alefsi/fem/geometry.hpp"
 #include "alefsi/la/krylov.hpp"
 #include "alefsi/mesh/generate/gmsh_mesher.hpp"
 #include "alefsi/sim/ale_flow.hpp"
@@ -124,6 +126,85 @@ TEST_CASE("gmsh_box_mesh refuses, by name, the scenes it cannot mesh", "[gmsh][q
   const std::vector<Sphere> s = {{Vec<3>(0, 0, 0.1275), 0.0075, 7}};
   const Mesh<3> m = gmsh_box_mesh(small, s, graded_size(s, 0.004, 0.02, 0.3));
   for (int t = 1; t <= 7; ++t) CHECK(!m.boundary_nodes(t).empty());
+}
+
+TEST_CASE("remove_caps: a cell with two faces on a body's surface goes, its other faces take their place",
+          "[gmsh][quick]") {
+  // The combinatorics only (remove_caps reads no coordinates): the cell 0123 with its faces 012
+  // and 013 on the body (tag 7), a neighbour 0234 across face 023 with a face on another
+  // surface (tag 3).
+  std::vector<Mesh<3>::Cell> cells = {{0, 1, 2, 3}, {0, 2, 3, 4}};
+  std::vector<Mesh<3>::Facet> facets = {{0, 1, 2}, {0, 1, 3}, {2, 3, 4}};
+  std::vector<int> tags = {7, 7, 3};
+  CHECK(detail::remove_caps(cells, facets, tags, {7}) == 1);
+  REQUIRE(cells.size() == 1);
+  CHECK(cells[0] == Mesh<3>::Cell{0, 2, 3, 4});
+  // the other surface's facet first and unchanged, then the cap's two other faces on the body
+  REQUIRE(facets.size() == 3);
+  CHECK(facets[0] == Mesh<3>::Facet{2, 3, 4});
+  CHECK(tags == std::vector<int>{3, 7, 7});
+  CHECK(facets[1] == Mesh<3>::Facet{0, 2, 3});
+  CHECK(facets[2] == Mesh<3>::Facet{1, 2, 3});
+  // a cell with one face on the body, or two on different surfaces, stays
+  std::vector<Mesh<3>::Cell> c2 = {{0, 1, 2, 3}};
+  std::vector<Mesh<3>::Facet> f2 = {{0, 1, 2}, {0, 1, 3}};
+  std::vector<int> t2 = {7, 8};
+  CHECK(detail::remove_caps(c2, f2, t2, {7, 8}) == 0);
+  t2 = {7, 3};
+  CHECK(detail::remove_caps(c2, f2, t2, {7}) == 0);
+  CHECK(c2.size() == 1);
+  // not a body's surface: left alone
+  t2 = {3, 3};
+  CHECK(detail::remove_caps(c2, f2, t2, {7}) == 0);
+}
+
+TEST_CASE("gmsh_ellipsoid_in_sphere_mesh: both surfaces exact and tagged, their areas converging at order 2, "
+          "no cap on the body, the cells curved onto it valid",
+          "[gmsh][quick]") {
+  const Real L = 3;
+  const Vec<3> s(1, 0.5, 0.5);  // a prolate spheroid, its axis along x
+  const Real e = std::sqrt(1 - s[1] * s[1] / (s[0] * s[0]));
+  const Real spheroid_area = 2 * pi * s[1] * s[1] * (1 + s[0] / (s[1] * e) * std::asin(e));
+  std::vector<Real> d_body, d_wall;
+  for (Real h : {0.2, 0.1, 0.05}) {
+    GmshMeshReport rep;
+    const auto size = [h](const Vec<3>& x) { return std::min(8 * h, h + 0.3 * std::max(Real(0), x.norm() - 1)); };
+    const Mesh<3> m = gmsh_ellipsoid_in_sphere_mesh(L, s, size, {}, &rep, 1, 2);
+    std::cout << "gmsh_ellipsoid_in_sphere_mesh h = " << h << ": " << rep.cells << " cells, " << rep.seconds
+              << " s, worst quality " << rep.quality.worst << ", caps removed " << rep.caps_removed << "\n";
+    CHECK(rep.quality.worst > 0.2);
+    Real body = 0, wall = 0;
+    std::vector<int> on_body(std::size_t(m.n_cells()), 0);
+    for (Index f : m.boundary_facets()) {
+      const int t = m.facet_tag(f);
+      REQUIRE((t == 1 || t == 2));
+      (t == 1 ? body : wall) += m.facet_measure(f);
+      for (Index v : m.facet(f)) {
+        const Real r = t == 1 ? m.node(v).cwiseQuotient(s).norm() : m.node(v).norm() / L;
+        CHECK(std::abs(r - 1) < 1e-15);
+      }
+      if (t == 1) ++on_body[std::size_t(m.facet_cells(f)[0])];
+    }
+    CHECK(*std::max_element(on_body.begin(), on_body.end()) == 1);  // no cap left
+    d_body.push_back(spheroid_area - body);  // inscribed polyhedra: less area
+    d_wall.push_back(4 * pi * L * L - wall);
+    CHECK(d_body.back() > 0);
+    CHECK(d_wall.back() > 0);
+    // curved cells on both surfaces: every cell's map stays invertible (a cap would not)
+    QuadraticGeometry<3> g(m);
+    project_boundary_edges(g, 1, onto_ellipsoid<3>(Vec<3>::Zero(), s));
+    project_boundary_edges(g, 2, onto_sphere<3>(Vec<3>::Zero(), L));
+  }
+  for (int l = 0; l < 2; ++l) {
+    const Real ob = std::log2(d_body[l] / d_body[l + 1]);
+    INFO("spheroid area error " << d_body[l] << " -> " << d_body[l + 1] << " (order " << ob << ")");
+    CHECK(ob == Approx(2).margin(0.3));
+  }
+  // bad input, named
+  const auto h = [](const Vec<3>&) { return 0.2; };
+  CHECK_THROWS_WITH(gmsh_ellipsoid_in_sphere_mesh(1.4, s, h), Catch::Contains("radius"));
+  CHECK_THROWS_WITH(gmsh_ellipsoid_in_sphere_mesh(L, Vec<3>(1, -0.5, 0.5), h), Catch::Contains("semi_axes"));
+  CHECK_THROWS_WITH(gmsh_ellipsoid_in_sphere_mesh(L, s, h, {}, nullptr, 2, 2), Catch::Contains("body_tag"));
 }
 
 namespace {

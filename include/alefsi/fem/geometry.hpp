@@ -299,4 +299,19 @@ auto onto_sphere(const Vec<D>& centre, Real radius) {
   };
 }
 
+/// The radial projection onto the axis-aligned ellipsoid (ellipse in 2D) about `centre` with
+/// semi-axes `semi_axes`: x -> c + (x - c) / l(x), l(x) = |diag(semi_axes)^{-1} (x - c)|. Not the
+/// nearest point, but a smooth map onto the surface, which is what a curved edge's point needs
+/// (its distance from the chord's midpoint stays O(h^2)). Undefined at the centre.
+template <int D>
+auto onto_ellipsoid(const Vec<D>& centre, const Vec<D>& semi_axes) {
+  ALEFSI_CHECK_ARG(semi_axes.minCoeff() > 0 && semi_axes.allFinite(), "semi_axes", "must be positive and finite");
+  return [centre, inv = Vec<D>(semi_axes.cwiseInverse())](const Vec<D>& x) -> Vec<D> {
+    const Vec<D> d = x - centre;
+    const Real l = d.cwiseProduct(inv).norm();
+    ALEFSI_CHECK_ARG(l > 0, "x", "the projection onto an ellipsoid is undefined at its centre");
+    return centre + d / l;
+  };
+}
+
 }  // namespace alefsi

@@ -25,14 +25,17 @@
 #endif
 #include <gmsh.h>
 
+#include <algorithm>
 #include <chrono>
-#include <map>
 #include <cmath>
+#include <functional>
+#include <map>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "alefsi/core/error.hpp"
+#include "alefsi/fem/geometry.hpp"
 #include "alefsi/mesh/generate/spheres_in_box.hpp"
 #include "alefsi/mesh/mesh.hpp"
 #include "alefsi/mesh/quality.hpp"
@@ -55,6 +58,10 @@ struct GmshMeshReport {
   Real seconds = 0;  ///< wall time of the call (geometry, meshing, conversion)
   Index cells = 0, nodes = 0;
   QualityStats quality;  ///< of the result
+  /// Cells removed as caps of a body: a tetrahedron with two faces on one body's surface lies
+  /// between them and the surface's other diagonal, inside the body (which is convex there), and
+  /// would be turned inside out when the faces are curved onto the surface (`remove_caps`).
+  Index caps_removed = 0;
 };
 
 namespace detail {
@@ -89,38 +96,77 @@ inline int classify_surface(const BoxDomain& box, const std::vector<Sphere>& sph
   return -1;
 }
 
-inline Mesh<3> gmsh_box_mesh_impl(const BoxDomain& box, const std::vector<Sphere>& spheres, const SizeFunction3D& size,
-                                  const GmshMeshOptions& opt) {
-  GmshSession session(opt.verbosity);
-  namespace occ = gmsh::model::occ;
-  const Vec<3> L = box.hi - box.lo;
-  const int solid = occ::addBox(box.lo[0], box.lo[1], box.lo[2], L[0], L[1], L[2]);
-  gmsh::vectorpair holes, fluid;
-  for (const Sphere& s : spheres) holes.emplace_back(3, occ::addSphere(s.centre[0], s.centre[1], s.centre[2], s.radius));
-  if (holes.empty()) {
-    fluid = {{3, solid}};
-  } else {
-    std::vector<gmsh::vectorpair> map;
-    occ::cut({{3, solid}}, holes, fluid, map);
-  }
-  occ::synchronize();
-  if (fluid.size() != 1 || fluid[0].first != 3)
-    throw MeshError(MeshError::Entity::mesh, -1, "gmsh: the box minus the spheres is not one volume");
+// Meshes the model's volume with alefsi's settings (Frontal-Delaunay surfaces, Delaunay volume,
+// gmsh's optimiser, sizes from `size` only) and converts it: the tetrahedra (positively
+// oriented, nodes numbered in gmsh's order, unused ones dropped) and the triangles of each
+// surface in `surfaces` (gmsh surface -> alefsi tag, in increasing gmsh order), whose nodes are
+// moved by that surface's `onto` (if set) onto the exact surface; the bodies' caps removed
+// (`caps`: how many).
+struct GmshSurface {
+  int tag = 0;                                // the facets' tag
+  std::function<Vec<3>(const Vec<3>&)> onto;  // onto the exact surface (null: left as gmsh put it)
+  bool body = false;                          // a body's surface (convex: its caps are removed)
+};
 
-  // which tag each surface's triangles get
-  gmsh::vectorpair surfaces;
-  gmsh::model::getEntities(surfaces, 2);
-  std::map<int, int> surface_tag;  // ordered: the facets in the same order every time
-  for (const auto& [dim, s] : surfaces) {
-    double x, y, z;
-    occ::getCenterOfMass(dim, s, x, y, z);
-    const int which = classify_surface(box, spheres, Vec<3>(x, y, z));
-    if (which < 0)
-      throw MeshError(MeshError::Entity::mesh, -1, "gmsh: surface " + std::to_string(s) +
-                                                       " is neither a face of the box nor a sphere");
-    surface_tag[s] = which < 6 ? box.tags[which] : -which;  // spheres: -(6 + k), resolved below
+// Removes the caps of the body surfaces whose tags are `body_tags`: a cell with two or more
+// faces tagged with one body's tag has all its vertices on that surface, so it lies inside the
+// body's convex hull, in a fold of the triangulated surface (two facets meeting in a valley
+// where the other diagonal of their quadrilateral would make a ridge). Its other faces take its
+// place on the surface, which then has the ridge. Repeated until no cap is left; returns the
+// number removed.
+inline Index remove_caps(std::vector<Mesh<3>::Cell>& cells, std::vector<Mesh<3>::Facet>& facets,
+                         std::vector<int>& facet_tags, const std::vector<int>& body_tags) {
+  auto key = [](std::array<Index, 3> f) {
+    std::sort(f.begin(), f.end());
+    return f;
+  };
+  std::map<std::array<Index, 3>, int> tagged;  // body facets, sorted vertices -> tag
+  for (std::size_t i = 0; i < facets.size(); ++i)
+    if (std::find(body_tags.begin(), body_tags.end(), facet_tags[i]) != body_tags.end())
+      tagged[key(facets[i])] = facet_tags[i];
+  if (tagged.empty()) return 0;
+  Index removed = 0;
+  std::vector<char> gone(cells.size(), 0);
+  for (bool again = true; again;) {
+    again = false;
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      if (gone[c]) continue;
+      std::array<std::array<Index, 3>, 4> face;
+      std::array<int, 4> tag{0, 0, 0, 0};
+      for (int j = 0; j < 4; ++j) {
+        face[std::size_t(j)] = key({cells[c][(j + 1) % 4], cells[c][(j + 2) % 4], cells[c][(j + 3) % 4]});
+        const auto it = tagged.find(face[std::size_t(j)]);
+        if (it != tagged.end()) tag[std::size_t(j)] = it->second;
+      }
+      int on = 0, body = 0;
+      for (int t : tag)
+        if (t != 0 && (body == 0 || t == body)) body = t, ++on;
+      if (on < 2) continue;
+      for (std::size_t j = 0; j < 4; ++j) {
+        if (tag[j] == body)
+          tagged.erase(face[j]);
+        else
+          tagged[face[j]] = body;
+      }
+      gone[c] = 1, ++removed, again = true;
+    }
   }
-
+  if (removed == 0) return 0;
+  std::size_t n = 0;
+  for (std::size_t c = 0; c < cells.size(); ++c)
+    if (!gone[c]) cells[n++] = cells[c];
+  cells.resize(n);
+  std::vector<Mesh<3>::Facet> kept;
+  std::vector<int> kept_tags;
+  for (std::size_t i = 0; i < facets.size(); ++i)  // the other surfaces' facets, in their order
+    if (std::find(body_tags.begin(), body_tags.end(), facet_tags[i]) == body_tags.end())
+      kept.push_back(facets[i]), kept_tags.push_back(facet_tags[i]);
+  for (const auto& [f, t] : tagged) kept.push_back({f[0], f[1], f[2]}), kept_tags.push_back(t);
+  facets = std::move(kept), facet_tags = std::move(kept_tags);
+  return removed;
+}
+inline Mesh<3> gmsh_generate(const std::map<int, GmshSurface>& surfaces, const SizeFunction3D& size,
+                             const GmshMeshOptions& opt, Index& caps) {
   gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
   gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
   gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
@@ -156,25 +202,20 @@ inline Mesh<3> gmsh_box_mesh_impl(const BoxDomain& box, const std::vector<Sphere
     return i;
   };
 
-  // boundary triangles, and the spheres' nodes put exactly on their spheres
+  // boundary triangles, their nodes put on the exact surfaces
   std::vector<Mesh<3>::Facet> facets;
   std::vector<int> facet_tags;
-  for (const auto& [s, t] : surface_tag) {
+  for (const auto& [s, surface] : surfaces) {
     std::vector<std::size_t> tri_tags, tri_nodes;
     gmsh::model::mesh::getElementsByType(2, tri_tags, tri_nodes, s);
-    const int tag = t >= 0 ? t : spheres[-t - 6].tag;
     for (std::size_t e = 0; e < tri_tags.size(); ++e) {
       Mesh<3>::Facet f;
       for (int j = 0; j < 3; ++j) {
         f[j] = node(tri_nodes[3 * e + j]);
-        if (t < 0) {
-          const Sphere& sp = spheres[-t - 6];
-          const Vec<3> r = x[f[j]] - sp.centre;
-          x[f[j]] = sp.centre + sp.radius * (r / r.norm());
-        }
+        if (surface.onto) x[f[j]] = surface.onto(x[f[j]]);  // idempotent: shared nodes may come twice
       }
       facets.push_back(f);
-      facet_tags.push_back(tag);
+      facet_tags.push_back(surface.tag);
     }
   }
   std::vector<Mesh<3>::Cell> cells(tet_tags.size());
@@ -183,23 +224,98 @@ inline Mesh<3> gmsh_box_mesh_impl(const BoxDomain& box, const std::vector<Sphere
     const Vec<3> a = x[cells[e][0]];
     if ((x[cells[e][1]] - a).dot((x[cells[e][2]] - a).cross(x[cells[e][3]] - a)) < 0) std::swap(cells[e][2], cells[e][3]);
   }
+  std::vector<int> body_tags;
+  for (const auto& [s, surface] : surfaces)
+    if (surface.body) body_tags.push_back(surface.tag);
+  caps = remove_caps(cells, facets, facet_tags, body_tags);
   return Mesh<3>(std::move(x), std::move(cells), facets, facet_tags);
 }
 
-}  // namespace detail
+inline Mesh<3> gmsh_box_mesh_impl(const BoxDomain& box, const std::vector<Sphere>& spheres, const SizeFunction3D& size,
+                                  const GmshMeshOptions& opt, Index& caps) {
+  GmshSession session(opt.verbosity);
+  namespace occ = gmsh::model::occ;
+  const Vec<3> L = box.hi - box.lo;
+  const int solid = occ::addBox(box.lo[0], box.lo[1], box.lo[2], L[0], L[1], L[2]);
+  gmsh::vectorpair holes, fluid;
+  for (const Sphere& s : spheres) holes.emplace_back(3, occ::addSphere(s.centre[0], s.centre[1], s.centre[2], s.radius));
+  if (holes.empty()) {
+    fluid = {{3, solid}};
+  } else {
+    std::vector<gmsh::vectorpair> map;
+    occ::cut({{3, solid}}, holes, fluid, map);
+  }
+  occ::synchronize();
+  if (fluid.size() != 1 || fluid[0].first != 3)
+    throw MeshError(MeshError::Entity::mesh, -1, "gmsh: the box minus the spheres is not one volume");
 
-/// A mesh of `box` minus the `spheres` with edge lengths near `size` (file comment). Throws
-/// InvalidArgument naming the body for a scene it cannot mesh (check_spheres_in_box), MeshError
-/// when gmsh fails or the worst cell is below `opt.quality_floor`.
-inline Mesh<3> gmsh_box_mesh(const BoxDomain& box, const std::vector<Sphere>& spheres, const SizeFunction3D& size,
-                             const GmshMeshOptions& opt = {}, GmshMeshReport* report = nullptr) {
-  check_spheres_in_box(box, spheres);
-  opt.validate();
-  ALEFSI_CHECK_ARG(static_cast<bool>(size), "size", "a size function is needed");
+  // which tag each surface's triangles get; the spheres' nodes put exactly on their spheres
+  gmsh::vectorpair entities;
+  gmsh::model::getEntities(entities, 2);
+  std::map<int, GmshSurface> surfaces;  // ordered: the facets in the same order every time
+  for (const auto& [dim, s] : entities) {
+    double x, y, z;
+    occ::getCenterOfMass(dim, s, x, y, z);
+    const int which = classify_surface(box, spheres, Vec<3>(x, y, z));
+    if (which < 0)
+      throw MeshError(MeshError::Entity::mesh, -1, "gmsh: surface " + std::to_string(s) +
+                                                       " is neither a face of the box nor a sphere");
+    if (which < 6) {
+      surfaces[s] = {box.tags[which], nullptr};
+    } else {
+      const Sphere& sp = spheres[std::size_t(which - 6)];
+      surfaces[s] = {sp.tag, [&sp](const Vec<3>& p) -> Vec<3> {
+                       const Vec<3> r = p - sp.centre;
+                       return sp.centre + sp.radius * (r / r.norm());
+                     },
+                     true};
+    }
+  }
+  return gmsh_generate(surfaces, size, opt, caps);
+}
+
+// An axis-aligned ellipsoid (semi-axes `semi_axes`, centred at the origin) cut out of the ball
+// of radius `radius` about the origin.
+inline Mesh<3> gmsh_ellipsoid_in_sphere_impl(Real radius, const Vec<3>& semi_axes, int body_tag, int container_tag,
+                                             const SizeFunction3D& size, const GmshMeshOptions& opt, Index& caps) {
+  GmshSession session(opt.verbosity);
+  namespace occ = gmsh::model::occ;
+  const int ball = occ::addSphere(0, 0, 0, radius);
+  const int body = occ::addSphere(0, 0, 0, 1);
+  occ::dilate({{3, body}}, 0, 0, 0, semi_axes[0], semi_axes[1], semi_axes[2]);
+  gmsh::vectorpair fluid;
+  std::vector<gmsh::vectorpair> map;
+  occ::cut({{3, ball}}, {{3, body}}, fluid, map);
+  occ::synchronize();
+  if (fluid.size() != 1 || fluid[0].first != 3)
+    throw MeshError(MeshError::Entity::mesh, -1, "gmsh: the ball minus the ellipsoid is not one volume");
+  gmsh::vectorpair entities;
+  gmsh::model::getEntities(entities, 2);
+  std::map<int, GmshSurface> surfaces;
+  for (const auto& [dim, s] : entities) {  // the container reaches `radius`, the body max(semi_axes)
+    double x0, y0, z0, x1, y1, z1;
+    gmsh::model::getBoundingBox(dim, s, x0, y0, z0, x1, y1, z1);
+    const Real reach = std::max({x1, y1, z1});
+    if (std::abs(reach - radius) < 1e-3 * radius)
+      surfaces[s] = {container_tag, onto_sphere<3>(Vec<3>::Zero(), radius)};
+    else if (std::abs(reach - semi_axes.maxCoeff()) < 1e-3 * semi_axes.maxCoeff())
+      surfaces[s] = {body_tag, onto_ellipsoid<3>(Vec<3>::Zero(), semi_axes), true};
+    else
+      throw MeshError(MeshError::Entity::mesh, -1, "gmsh: surface " + std::to_string(s) +
+                                                       " is neither the container nor the ellipsoid");
+  }
+  return gmsh_generate(surfaces, size, opt, caps);
+}
+
+// Runs `make(caps)` (a gmsh call), turning gmsh's errors into MeshError, and refuses a result
+// below the quality floor; fills `report`.
+template <class Make>
+Mesh<3> gmsh_checked(Make&& make, const GmshMeshOptions& opt, GmshMeshReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
   Mesh<3> mesh;
+  Index caps = 0;
   try {
-    mesh = detail::gmsh_box_mesh_impl(box, spheres, size, opt);
+    mesh = make(caps);
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
@@ -212,12 +328,49 @@ inline Mesh<3> gmsh_box_mesh(const BoxDomain& box, const std::vector<Sphere>& sp
   const QualityStats q = quality_stats(mesh);
   if (q.worst < opt.quality_floor)
     throw MeshError(MeshError::Entity::mesh, -1,
-                    detail::concat("the new mesh's worst quality ", q.worst, " is below the floor ", opt.quality_floor,
-                                   " (dihedral angles ", q.min_dihedral_deg, " to ", q.max_dihedral_deg, " degrees)"));
+                    concat("the new mesh's worst quality ", q.worst, " is below the floor ", opt.quality_floor,
+                           " (dihedral angles ", q.min_dihedral_deg, " to ", q.max_dihedral_deg, " degrees)"));
   if (report)
     *report = {std::chrono::duration<Real>(std::chrono::steady_clock::now() - t0).count(), mesh.n_cells(),
-               mesh.n_nodes(), q};
+               mesh.n_nodes(), q, caps};
   return mesh;
+}
+
+}  // namespace detail
+
+/// A mesh of `box` minus the `spheres` with edge lengths near `size` (file comment). Throws
+/// InvalidArgument naming the body for a scene it cannot mesh (check_spheres_in_box), MeshError
+/// when gmsh fails or the worst cell is below `opt.quality_floor`.
+inline Mesh<3> gmsh_box_mesh(const BoxDomain& box, const std::vector<Sphere>& spheres, const SizeFunction3D& size,
+                             const GmshMeshOptions& opt = {}, GmshMeshReport* report = nullptr) {
+  check_spheres_in_box(box, spheres);
+  opt.validate();
+  ALEFSI_CHECK_ARG(static_cast<bool>(size), "size", "a size function is needed");
+  return detail::gmsh_checked([&](Index& caps) { return detail::gmsh_box_mesh_impl(box, spheres, size, opt, caps); },
+                              opt, report);
+}
+
+/// A mesh of the ball |x| < `radius` minus the ellipsoid sum (x_i / semi_axes_i)^2 < 1 (both
+/// about the origin, the ellipsoid's axes along the coordinate axes), with edge lengths near
+/// `size`: the ellipsoid's facets tagged `body_tag`, the sphere's `container_tag`, every node of
+/// the sphere on it and every node of the ellipsoid on it (radial projection, `onto_ellipsoid`).
+/// A body turned in a flow is the flow turned about the body (scenes/jeffery3d.hpp). Throws
+/// InvalidArgument naming the parameter, MeshError as gmsh_box_mesh.
+inline Mesh<3> gmsh_ellipsoid_in_sphere_mesh(Real radius, const Vec<3>& semi_axes, const SizeFunction3D& size,
+                                             const GmshMeshOptions& opt = {}, GmshMeshReport* report = nullptr,
+                                             int body_tag = 1, int container_tag = 2) {
+  ALEFSI_CHECK_ARG(semi_axes.minCoeff() > 0 && semi_axes.allFinite(), "semi_axes", "must be positive and finite, got ",
+                   semi_axes.transpose());
+  ALEFSI_CHECK_ARG(std::isfinite(radius) && radius > 1.5 * semi_axes.maxCoeff(), "radius",
+                   "the container must reach past 1.5 times the largest semi-axis, got ", radius);
+  ALEFSI_CHECK_ARG(body_tag != container_tag, "body_tag", "must differ from container_tag (", container_tag, ")");
+  opt.validate();
+  ALEFSI_CHECK_ARG(static_cast<bool>(size), "size", "a size function is needed");
+  return detail::gmsh_checked(
+      [&](Index& caps) {
+        return detail::gmsh_ellipsoid_in_sphere_impl(radius, semi_axes, body_tag, container_tag, size, opt, caps);
+      },
+      opt, report);
 }
 
 }  // namespace alefsi

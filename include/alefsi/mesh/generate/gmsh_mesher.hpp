@@ -45,6 +45,7 @@ namespace alefsi {
 struct GmshMeshOptions {
   Real quality_floor = 0.02;  ///< a mesh whose worst Mesh::quality is below is refused (MeshError)
   bool netgen = false;        ///< also run gmsh's Netgen optimiser (better worst cells, slower)
+  bool remove_caps = true;    ///< remove the bodies' caps (GmshMeshReport::caps_removed); false: gmsh's mesh as it is
   int verbosity = 0;          ///< gmsh's General.Verbosity (0: silent, 5: everything)
 
   void validate() const {
@@ -227,7 +228,7 @@ inline Mesh<3> gmsh_generate(const std::map<int, GmshSurface>& surfaces, const S
   std::vector<int> body_tags;
   for (const auto& [s, surface] : surfaces)
     if (surface.body) body_tags.push_back(surface.tag);
-  caps = remove_caps(cells, facets, facet_tags, body_tags);
+  caps = opt.remove_caps ? remove_caps(cells, facets, facet_tags, body_tags) : 0;
   return Mesh<3>(std::move(x), std::move(cells), facets, facet_tags);
 }
 

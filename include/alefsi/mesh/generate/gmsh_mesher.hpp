@@ -1,9 +1,10 @@
 #pragma once
 /// \file mesh/generate/gmsh_mesher.hpp
-/// Tetrahedral meshes of a box with spherical holes (mesh/generate/spheres_in_box.hpp), made by
-/// gmsh's C++ API: the box minus the spheres by OpenCASCADE, surface meshes by Frontal-Delaunay,
-/// the volume by Delaunay with gmsh's optimiser, the size given by a SizeFunction3D (gmsh asks
-/// it at every point it inserts). Needs gmsh (GPL; Debian: libgmsh-dev): link alefsi::gmsh,
+/// Tetrahedral meshes of a box with spherical holes (mesh/generate/spheres_in_box.hpp,
+/// `gmsh_box_mesh`) and of a ball with an ellipsoidal hole (`gmsh_ellipsoid_in_sphere_mesh`),
+/// made by gmsh's C++ API: the solid minus the holes by OpenCASCADE, surface meshes by
+/// Frontal-Delaunay, the volume by Delaunay with gmsh's optimiser, the size given by a
+/// SizeFunction3D (gmsh asks it at every point it inserts). Needs gmsh (GPL; Debian: libgmsh-dev): link alefsi::gmsh,
 /// which CMake defines when it finds it (ALEFSI_WITH_GMSH); a program linking it is bound by
 /// gmsh's licence.
 ///
@@ -12,7 +13,10 @@
 /// its tag, and every node of a sphere's surface exactly on it (projected: |x - c| = r to
 /// round-off), so that a body's surface is its sphere wherever its nodes are placed from its
 /// rigid motion. The same input gives the same mesh (one thread): a run that remeshes restarts
-/// bit for bit from a checkpoint.
+/// bit for bit from a checkpoint. A cell with two faces on a body (a cap, in a fold of the
+/// surface triangulation: gmsh makes one in about a fifth of the meshes of a sphere in a box)
+/// is removed (`GmshMeshOptions::remove_caps`): it is a sliver, the worst cell of its mesh, and
+/// no curved cell could be made of it.
 ///
 /// gmsh keeps global state: the mesher initialises it for the call and finalises it after (a
 /// program must not hold its own gmsh session across the call). Failures (a gmsh error, a
@@ -97,12 +101,7 @@ inline int classify_surface(const BoxDomain& box, const std::vector<Sphere>& sph
   return -1;
 }
 
-// Meshes the model's volume with alefsi's settings (Frontal-Delaunay surfaces, Delaunay volume,
-// gmsh's optimiser, sizes from `size` only) and converts it: the tetrahedra (positively
-// oriented, nodes numbered in gmsh's order, unused ones dropped) and the triangles of each
-// surface in `surfaces` (gmsh surface -> alefsi tag, in increasing gmsh order), whose nodes are
-// moved by that surface's `onto` (if set) onto the exact surface; the bodies' caps removed
-// (`caps`: how many).
+// How a gmsh surface's triangles come out of `gmsh_generate`.
 struct GmshSurface {
   int tag = 0;                                // the facets' tag
   std::function<Vec<3>(const Vec<3>&)> onto;  // onto the exact surface (null: left as gmsh put it)
@@ -166,6 +165,13 @@ inline Index remove_caps(std::vector<Mesh<3>::Cell>& cells, std::vector<Mesh<3>:
   facets = std::move(kept), facet_tags = std::move(kept_tags);
   return removed;
 }
+
+// Meshes the model's volume with alefsi's settings (Frontal-Delaunay surfaces, Delaunay volume,
+// gmsh's optimiser, sizes from `size` only) and converts it: the tetrahedra (positively
+// oriented, nodes numbered in gmsh's order, unused ones dropped) and the triangles of each
+// surface in `surfaces` (gmsh surface -> alefsi tag, in increasing gmsh order), whose nodes are
+// moved by that surface's `onto` (if set) onto the exact surface; the bodies' caps removed
+// (`caps`: how many).
 inline Mesh<3> gmsh_generate(const std::map<int, GmshSurface>& surfaces, const SizeFunction3D& size,
                              const GmshMeshOptions& opt, Index& caps) {
   gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);

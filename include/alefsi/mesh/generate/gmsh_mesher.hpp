@@ -34,6 +34,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <numbers>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -283,12 +284,22 @@ inline Mesh<3> gmsh_box_mesh_impl(const BoxDomain& box, const std::vector<Sphere
 
 // An axis-aligned ellipsoid (semi-axes `semi_axes`, centred at the origin) cut out of the ball
 // of radius `radius` about the origin.
+// `poles_on_longest`: the unit sphere turned before it is stretched so that the poles of its
+// parametrisation end on the longest axis (else they stay on z).
 inline Mesh<3> gmsh_ellipsoid_in_sphere_impl(Real radius, const Vec<3>& semi_axes, int body_tag, int container_tag,
-                                             const SizeFunction3D& size, const GmshMeshOptions& opt, Index& caps) {
+                                             const SizeFunction3D& size, const GmshMeshOptions& opt,
+                                             bool poles_on_longest, Index& caps) {
   GmshSession session(opt.verbosity);
   namespace occ = gmsh::model::occ;
   const int ball = occ::addSphere(0, 0, 0, radius);
   const int body = occ::addSphere(0, 0, 0, 1);
+  if (poles_on_longest) {
+    Index longest = 0;
+    semi_axes.maxCoeff(&longest);
+    const Real half_pi = std::numbers::pi / 2;
+    if (longest == 0) occ::rotate({{3, body}}, 0, 0, 0, 0, 1, 0, half_pi);   // z -> x
+    if (longest == 1) occ::rotate({{3, body}}, 0, 0, 0, 1, 0, 0, -half_pi);  // z -> y
+  }
   occ::dilate({{3, body}}, 0, 0, 0, semi_axes[0], semi_axes[1], semi_axes[2]);
   gmsh::vectorpair fluid;
   std::vector<gmsh::vectorpair> map;
@@ -361,8 +372,12 @@ inline Mesh<3> gmsh_box_mesh(const BoxDomain& box, const std::vector<Sphere>& sp
 /// about the origin, the ellipsoid's axes along the coordinate axes), with edge lengths near
 /// `size`: the ellipsoid's facets tagged `body_tag`, the sphere's `container_tag`, every node of
 /// the sphere on it and every node of the ellipsoid on it (radial projection, `onto_ellipsoid`).
-/// A body turned in a flow is the flow turned about the body (scenes/jeffery3d.hpp). Throws
-/// InvalidArgument naming the parameter, MeshError as gmsh_box_mesh.
+/// A body turned in a flow is the flow turned about the body (scenes/jeffery3d.hpp). The
+/// ellipsoid is OpenCASCADE's unit sphere stretched, whose parametrisation has its poles on z;
+/// when gmsh's surface mesher fails on it (a slender spheroid along x: b / a = 0.33 and below
+/// at h = 0.08, the poles squeezed into slits), the mesh is made again with the poles turned
+/// onto the longest axis, at the tips. Throws InvalidArgument naming the parameter, MeshError
+/// as gmsh_box_mesh.
 inline Mesh<3> gmsh_ellipsoid_in_sphere_mesh(Real radius, const Vec<3>& semi_axes, const SizeFunction3D& size,
                                              const GmshMeshOptions& opt = {}, GmshMeshReport* report = nullptr,
                                              int body_tag = 1, int container_tag = 2) {
@@ -375,7 +390,15 @@ inline Mesh<3> gmsh_ellipsoid_in_sphere_mesh(Real radius, const Vec<3>& semi_axe
   ALEFSI_CHECK_ARG(static_cast<bool>(size), "size", "a size function is needed");
   return detail::gmsh_checked(
       [&](Index& caps) {
-        return detail::gmsh_ellipsoid_in_sphere_impl(radius, semi_axes, body_tag, container_tag, size, opt, caps);
+        try {
+          return detail::gmsh_ellipsoid_in_sphere_impl(radius, semi_axes, body_tag, container_tag, size, opt, false,
+                                                       caps);
+        } catch (const Error&) {
+          throw;
+        } catch (...) {  // gmsh could not mesh the squeezed parametrisation: the poles to the tips
+          return detail::gmsh_ellipsoid_in_sphere_impl(radius, semi_axes, body_tag, container_tag, size, opt, true,
+                                                       caps);
+        }
       },
       opt, report);
 }

@@ -88,7 +88,7 @@ struct Jeffery3D {
     ALEFSI_CHECK_ARG(std::abs(p.norm() - 1) < 1e-12, "p", "must be a unit vector, got |p| = ", p.norm());
     ALEFSI_CHECK_ARG(G.allFinite() && std::abs(G.trace()) <= 1e-12 * G.norm(), "G",
                      "must be finite and traceless (an incompressible linear flow), trace ", G.trace());
-    const Mat<3> R = Eigen::Quaternion<Real>::FromTwoVectors(Vec<3>::UnitX(), p).toRotationMatrix();
+    const Mat<3> R = body_axes(p);
     const Mat<3> Gb = R.transpose() * G * R;  // the flow about the body, in its axes
     // Stokes: rho = 1e-18 and one step of 1e-6 from rest (the mass term, 1e-12, far below the
     // solution's accuracy)
@@ -133,17 +133,16 @@ struct Jeffery3D {
   }
   /// The angular velocity (flow axes) with the axis along p in u = G x, from the mobility K.
   static Vec<3> from_mobility(const Eigen::Matrix<Real, 3, 5>& K, const Vec<3>& p, const Mat<3>& G) {
-    const Mat<3> R = Eigen::Quaternion<Real>::FromTwoVectors(Vec<3>::UnitX(), p).toRotationMatrix();
-    const Mat<3> Gb = R.transpose() * G * R, W = (Gb - Gb.transpose()) / 2, E = (Gb + Gb.transpose()) / 2;
+    const Mat<3> R = body_axes(p);
+    const Mat<3> Gb = R.transpose() * G * R, E = (Gb + Gb.transpose()) / 2;
     const Eigen::Matrix<Real, 5, 1> c(E(0, 1), E(0, 2), E(1, 2), -E(1, 1), -E(2, 2));
-    return R * (Vec<3>(W(2, 1), W(0, 2), W(1, 0)) + K * c);
+    return R * (half_vorticity(Gb) + K * c);
   }
 
   /// Jeffery's angular velocity (unbounded flow) with the axis along the unit vector p in u = G x.
   Vec<3> jeffery_angular_velocity(const Vec<3>& p, const Mat<3>& G) const {
-    const Mat<3> W = (G - G.transpose()) / 2, E = (G + G.transpose()) / 2;
-    const Vec<3> Omega(W(2, 1), W(0, 2), W(1, 0));  // W x = Omega x x
-    return Omega + jeffery_lambda() * p.cross(E * p);
+    const Mat<3> E = (G + G.transpose()) / 2;
+    return half_vorticity(G) + jeffery_lambda() * p.cross(E * p);
   }
   /// Jeffery's period of the orbit in the simple shear of rate gamma.
   Real jeffery_period(Real gamma = 1) const { return 2 * std::numbers::pi * (a / b + b / a) / gamma; }
@@ -151,6 +150,16 @@ struct Jeffery3D {
   Real jeffery_lambda() const {
     const Real r2 = (a / b) * (a / b);
     return (r2 - 1) / (r2 + 1);
+  }
+
+  /// The rotation R taking the mesh's axes to the body's, R e_x = p.
+  static Mat<3> body_axes(const Vec<3>& p) {
+    return Eigen::Quaternion<Real>::FromTwoVectors(Vec<3>::UnitX(), p).toRotationMatrix();
+  }
+  /// Omega, the axial vector of W = (G - G^T) / 2 (W x = Omega x x): half the vorticity of u = G x.
+  static Vec<3> half_vorticity(const Mat<3>& G) {
+    const Mat<3> W = (G - G.transpose()) / 2;
+    return Vec<3>(W(2, 1), W(0, 2), W(1, 0));
   }
 };
 

@@ -272,10 +272,10 @@ class BodySystem {
   /// velocity meets exactly and that of a slip tangent to the exact surface does not: through
   /// the flat facets it leaks an O(h^2) flux, which a pinned pressure DOF would absorb as a
   /// point source (and which leaves an unpinned system without a solution). So each body's
-  /// slip is applied less c n, n = r / |r|, c = Phi[u_s] / Phi[n] with Phi the discrete flux through its facets on this
-  /// mesh (surface_flux, in the body frame of its surface offsets): the same c while the mesh
-  /// moves (the surface moves rigidly), recomputed after each remesh. Elsewhere c = 0. Call
-  /// after `attach`, with the surface offsets of `states` on this mesh.
+  /// slip is applied less c n, n = r / |r|, c = Phi[u_s] / Phi[n] with Phi the discrete flux
+  /// through its facets on this mesh (surface_flux, in the body frame of its surface offsets):
+  /// the same c while the mesh moves (the surface moves rigidly), recomputed after each remesh.
+  /// Elsewhere c = 0. Call after `attach`, with the surface offsets of `states` on this mesh.
   void remove_slip_flux(const std::vector<State>& states, int velocity_degree, bool closed) {
     for (std::size_t k = 0; k < entries_.size(); ++k) {
       auto& e = entries_[k];

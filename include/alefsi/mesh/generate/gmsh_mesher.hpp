@@ -272,11 +272,7 @@ inline Mesh<3> gmsh_box_mesh_impl(const BoxDomain& box, const std::vector<Sphere
       surfaces[s] = {box.tags[which], nullptr};
     } else {
       const Sphere& sp = spheres[std::size_t(which - 6)];
-      surfaces[s] = {sp.tag, [&sp](const Vec<3>& p) -> Vec<3> {
-                       const Vec<3> r = p - sp.centre;
-                       return sp.centre + sp.radius * (r / r.norm());
-                     },
-                     true};
+      surfaces[s] = {sp.tag, onto_sphere<3>(sp.centre, sp.radius), true};
     }
   }
   return gmsh_generate(surfaces, size, opt, caps);

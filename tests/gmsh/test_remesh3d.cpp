@@ -419,6 +419,11 @@ TEST_CASE("a free spheroid in a linear flow: the rotation followed exactly, Jeff
   const Real lambda = scene.jeffery_lambda();
   CHECK(lambda == Approx(0.6).epsilon(1e-15));
   const Mesh<3> m4 = scene.mesh();
+  // bad input, named before anything is solved
+  CHECK_THROWS_WITH(scenes::Jeffery3D{.b = -0.5}.mesh(), Catch::Contains("a, b"));
+  CHECK_THROWS_WITH(scene.angular_velocity(m4, Vec<3>(1, 1, 0), Mat<3>::Zero()), Catch::Contains("unit vector"));
+  CHECK_THROWS_WITH(scene.angular_velocity(m4, Vec<3>::UnitX(), Mat<3>::Identity()), Catch::Contains("traceless"));
+  CHECK_THROWS_WITH(scenes::Jeffery3D::strain_basis(5), Catch::Contains("0..4"));
   // a rigid rotation about (1, 2, 3): followed to the solver's tolerance, whatever the mesh
   Mat<3> W;
   W << 0, -3, 2, 3, 0, -1, -2, 1, 0;  // W x = (1, 2, 3) x x

@@ -150,6 +150,50 @@ TEST_CASE("quadratic geometry: the annulus' area converges at O(h^4) with edge p
   }
 }
 
+TEST_CASE("onto_ellipsoid: the nearest point, on the surface, along its normal, no farther than any other point",
+          "[curved][quick]") {
+  // a slender triaxial ellipsoid and an ellipse; points outside, just inside (a chord's midpoint)
+  // and on the axis inside a tip's circle of curvature
+  auto check = [](const auto& s, const auto& points) {
+    constexpr int D = std::decay_t<decltype(s)>::RowsAtCompileTime;
+    const Vec<D> c = Vec<D>::Constant(0.3);
+    const auto onto = onto_ellipsoid<D>(c, s);
+    std::vector<Vec<D>> surface;  // a dense sample of the surface
+    const int n = D == 2 ? 20000 : 400;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < (D == 2 ? 1 : 2 * n); ++j) {
+        const Real th = pi * (i + 0.5) / n, ph = pi * j / n;
+        Vec<D> u;
+        if constexpr (D == 2) u = Vec<D>(std::cos(2 * th), std::sin(2 * th));
+        else u = Vec<D>(std::cos(th), std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph));
+        surface.push_back(c + s.cwiseProduct(u));
+      }
+    for (const Vec<D>& x : points) {
+      const Vec<D> y = onto(Vec<D>(c + x));
+      INFO("x - c = " << x.transpose() << ", y - c = " << (y - c).transpose());
+      CHECK(std::abs((y - c).cwiseQuotient(s).norm() - 1) < 1e-15);
+      const Vec<D> nrm = (y - c).cwiseQuotient(s.cwiseProduct(s)).normalized(), r = c + x - y;
+      CHECK((r - r.dot(nrm) * nrm).norm() < 1e-12 * (1 + r.norm()));  // along the normal
+      Real nearest = 1e300;
+      for (const Vec<D>& z : surface) nearest = std::min(nearest, (c + x - z).norm());
+      CHECK(r.norm() <= nearest + 1e-12);
+    }
+  };
+  const Vec<3> s3(1, 0.25, 0.4);
+  check(s3, std::vector<Vec<3>>{{1.3, 0.2, -0.1}, {0.2, -0.5, 0.6}, {-0.75, 0.16, 0.2},
+                                {0.98, 0.0, 0.0}, {0.5 * (0.95 + 0.9), 0.5 * 0.25 * (0.312 - 0.436), 0.0}});
+  const Vec<2> s2(1, 0.2);
+  check(s2, std::vector<Vec<2>>{{1.2, 0.1}, {-0.8, 0.1}, {0.0, -0.19}, {0.97, 0.0}, {3, 4}});
+  // the midpoint of a chord near a slender ellipse's tip moves along the normal by the sagitta
+  // (0.6 % of it along the chord: the curvature changes along it), where the radial projection
+  // moves it twice as far, 85 % of that along the chord
+  const Vec<2> p(std::cos(0.3), 0.2 * std::sin(0.3)), q(std::cos(0.45), 0.2 * std::sin(0.45)), m = (p + q) / 2;
+  const Vec<2> nearest = onto_ellipsoid<2>(Vec<2>::Zero(), s2)(m), radial = m / m.cwiseQuotient(s2).norm();
+  CHECK(std::abs((nearest - m).dot(q - p)) < 0.02 * (nearest - m).norm() * (q - p).norm());
+  CHECK(std::abs((radial - m).dot((q - p).normalized())) > 0.5 * (radial - m).norm());
+  CHECK_THROWS_WITH(onto_ellipsoid<2>(Vec<2>::Zero(), Vec<2>(1, 0)), Catch::Contains("semi_axes"));
+}
+
 TEST_CASE("quadratic geometry: the shell's volume error drops from O(h^2) to O(h^3) or better", "[curved][quick]") {
   // A P2 triangle through six points of a sphere leaves an O(h^3) gap, so the volume error is
   // O(h^3) at least (in 2D the arc's interpolation error is odd about the edge's midpoint and

@@ -33,6 +33,7 @@
 /// edge is on no boundary facet). The coefficients are fixed when the point is set. Both rules
 /// commute with rotations, translations and scaling, so a point whose frame nodes move rigidly
 /// (a body's surface) moves rigidly with them, and its velocity is the rigid velocity there.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
@@ -299,18 +300,51 @@ auto onto_sphere(const Vec<D>& centre, Real radius) {
   };
 }
 
-/// The radial projection onto the axis-aligned ellipsoid (ellipse in 2D) about `centre` with
-/// semi-axes `semi_axes`: x -> c + (x - c) / l(x), l(x) = |diag(semi_axes)^{-1} (x - c)|. Not the
-/// nearest point, but a smooth map onto the surface, which is what a curved edge's point needs
-/// (its distance from the chord's midpoint stays O(h^2)). Undefined at the centre.
+/// The nearest point on the axis-aligned ellipsoid (ellipse in 2D) about `centre` with semi-axes
+/// s: y_i = c_i + s_i^2 d_i / (s_i^2 + t), d = x - c, where t is the root of
+///     f(t) = sum_i (s_i d_i / (s_i^2 + t))^2 - 1
+/// on t > -min_i s_i^2, where f falls monotonically (the largest root: the nearest of the
+/// critical points). A curved edge's point has to move along the normal: a radial projection
+/// moves the midpoint of a chord of a slender body along it as well, by as much as the chord's
+/// sagitta over the cosine between the ray and the normal, and that tangential part folds the
+/// cells beside it. Deep inside, where the root is not in that range (x on a thin body's axis
+/// farther than a radius of curvature from the tip), the radial projection is returned: the
+/// nearest point is not unique there. Undefined at the centre.
 template <int D>
 auto onto_ellipsoid(const Vec<D>& centre, const Vec<D>& semi_axes) {
   ALEFSI_CHECK_ARG(semi_axes.minCoeff() > 0 && semi_axes.allFinite(), "semi_axes", "must be positive and finite");
-  return [centre, inv = Vec<D>(semi_axes.cwiseInverse())](const Vec<D>& x) -> Vec<D> {
+  return [centre, s = semi_axes](const Vec<D>& x) -> Vec<D> {
     const Vec<D> d = x - centre;
-    const Real l = d.cwiseProduct(inv).norm();
+    const Real l = d.cwiseQuotient(s).norm();
     ALEFSI_CHECK_ARG(l > 0, "x", "the projection onto an ellipsoid is undefined at its centre");
-    return centre + d / l;
+    const Vec<D> s2 = s.cwiseProduct(s), sd = s.cwiseProduct(d);
+    const auto f = [&](Real t, Real* df) {
+      Real v = -1, dv = 0;
+      for (int i = 0; i < D; ++i) {
+        const Real q = sd[i] / (s2[i] + t);
+        v += q * q;
+        dv -= 2 * q * q / (s2[i] + t);
+      }
+      if (df) *df = dv;
+      return v;
+    };
+    // the bracket: f(lo) > 0 just right of the pole, f(hi) <= 0 at hi = max_i s_i |d|
+    Real lo = -s2.minCoeff() * (1 - 1e-12), hi = s.maxCoeff() * d.norm();
+    if (!(f(lo, nullptr) > 0)) return Vec<D>(centre + d / l);  // deep inside a thin body
+    Real t = std::clamp(Real(0), lo, hi);                      // near the surface t is near 0
+    for (int it = 0; it < 200; ++it) {
+      Real df = 0;
+      const Real v = f(t, &df);
+      if (v == 0) break;
+      (v > 0 ? lo : hi) = t;
+      Real tn = t - v / df;                   // Newton,
+      if (!(tn > lo && tn < hi)) tn = (lo + hi) / 2;  // kept in the bracket by bisection
+      const bool done = std::abs(tn - t) <= 1e-14 * s2.maxCoeff();
+      t = tn;
+      if (done) break;
+    }
+    const Vec<D> y = s2.cwiseProduct(d).cwiseQuotient((s2.array() + t).matrix());
+    return Vec<D>(centre + y / y.cwiseQuotient(s).norm());  // on the surface to round-off
   };
 }
 

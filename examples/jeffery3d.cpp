@@ -17,7 +17,7 @@
 // axis) beside Jeffery's from the same start.
 //
 // How to run:   ./jeffery3d [--aspect 2] [--container 8] [--h-body 0.1] [--grading 0.3]
-//               [--no-curved] [--output DIR]        (`--help` lists the options)
+//               [--cells-per-turn 16] [--no-curved] [--output DIR]        (`--help` lists the options)
 // What it prints: the mesh, the five columns of K with GMRES's iterations, lambda_h against
 //   lambda, the superposition check, T_h against T_J = 2 pi (r + 1 / r), the largest angle
 //   between the computed and Jeffery's axis over each orbit, and a summary line. It writes
@@ -60,7 +60,7 @@ Real angle(const Vec<3>& u, const Vec<3>& v) { return std::atan2(u.cross(v).norm
 
 int main(int argc, char** argv) try {
   std::filesystem::path out = "output";
-  Real aspect = 2, container = 8, h_body = 0.1, grading = 0.3, h_far = 1;
+  Real aspect = 2, container = 8, h_body = 0.1, grading = 0.3, h_far = 1, cells_per_turn = 16;
   bool curved = true;
   Options opt("jeffery3d", "A free spheroid in simple shear (Stokes): its mobility and orbits against Jeffery's.");
   opt.add("aspect", aspect, "aspect ratio a / b of the prolate spheroid (a = 1 along its axis)")
@@ -68,13 +68,15 @@ int main(int argc, char** argv) try {
       .add("h-body", h_body, "mesh size at the spheroid")
       .add("grading", grading, "growth of the mesh size with the distance from the body")
       .add("h-far", h_far, "largest mesh size")
+      .add("cells-per-turn", cells_per_turn,
+           "size at most 2 pi rho / N where the surface's radius of curvature rho is small (0: off)")
       .flag("curved", curved, "isoparametric P2 cells on the spheroid and the container (--no-curved: polyhedra)")
       .add("output", out, "folder for jeffery3d.csv");
   if (!opt.parse(argc, argv, std::cout)) return 0;
   ALEFSI_CHECK_ARG(aspect >= 1 && std::isfinite(aspect), "--aspect", "must be >= 1, got ", aspect);
   opt.print(std::cout);
   scenes::Jeffery3D scene{.b = 1 / aspect, .container = container, .h_body = h_body, .h_far = h_far,
-                          .grading = grading, .curved = curved};
+                          .grading = grading, .cells_per_turn = cells_per_turn, .curved = curved};
   scene.validate();
   const auto wall0 = std::chrono::steady_clock::now();
   const std::clock_t c0 = std::clock();

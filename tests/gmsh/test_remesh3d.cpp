@@ -204,16 +204,40 @@ TEST_CASE("gmsh_ellipsoid_in_sphere_mesh: both surfaces exact and tagged, their 
     CHECK(ob == Approx(2).margin(0.3));
   }
   // a slender spheroid (b / a = 1/4): gmsh's surface mesher fails on the stretched sphere's
-  // squeezed poles, and the mesher makes it again with the poles at the tips
-  const Vec<3> s4(1, 0.25, 0.25);
+  // squeezed poles, and the mesher makes it again with the poles at the tips. Jeffery3D's size
+  // follows the curvature: at the tips (radius of curvature b^2 / a) 2 pi b^2 / (16 a) = 0.0245
+  // instead of h_body = 0.07. Its cells curve onto the spheroid (the nearest point: the radial
+  // projection folded cells here)
+  const scenes::Jeffery3D slender{.b = 0.25, .container = L, .h_body = 0.07, .h_far = 0.5};
+  const Vec<3> s4 = slender.semi_axes();
+  CHECK(slender.curvature_radius(Vec<3>(1, 0, 0)) == Approx(0.0625).epsilon(1e-14));
+  CHECK(slender.curvature_radius(Vec<3>(0, 0.25, 0)) == Approx(0.25).epsilon(1e-14));  // the parallel's b
+  CHECK(slender.size(Vec<3>(1, 0, 0)) == Approx(2 * pi * 0.0625 / 16).epsilon(1e-14));
+  CHECK(slender.size(Vec<3>(0, 0.25, 0)) == 0.07);
   GmshMeshReport rep4;
-  const Mesh<3> m4 = gmsh_ellipsoid_in_sphere_mesh(
-      L, s4, [](const Vec<3>& x) { return std::min(Real(0.5), 0.07 + 0.3 * std::max(Real(0), x.norm() - 1)); }, {},
-      &rep4);
+  const Mesh<3> m4 = slender.mesh(&rep4);
   CHECK(rep4.quality.worst > 0.2);
+  Real tip_edge = 0;  // the longest body edge from a node within 0.03 of a tip
+  int at_tips = 0;
   for (Index f : m4.boundary_facets())
-    if (m4.facet_tag(f) == 1)
-      for (Index v : m4.facet(f)) CHECK(std::abs(m4.node(v).cwiseQuotient(s4).norm() - 1) < 1e-15);
+    if (m4.facet_tag(f) == 1) {
+      const auto& v = m4.facet(f);
+      for (int i = 0; i < 3; ++i) {
+        CHECK(std::abs(m4.node(v[std::size_t(i)]).cwiseQuotient(s4).norm() - 1) < 1e-15);
+        const Vec<3> p = m4.node(v[std::size_t(i)]), q = m4.node(v[std::size_t((i + 1) % 3)]);
+        if ((Vec<3>(std::abs(p[0]), p[1], p[2]) - Vec<3>::UnitX()).norm() < 0.03) {
+          tip_edge = std::max(tip_edge, (p - q).norm());
+          ++at_tips;
+        }
+      }
+    }
+  INFO("longest edge at the tips " << tip_edge << " (" << at_tips << " edges)");
+  CHECK(at_tips > 0);
+  CHECK(tip_edge < 0.045);
+  QuadraticGeometry<3> g4(m4);
+  project_boundary_edges(g4, 1, onto_ellipsoid<3>(Vec<3>::Zero(), s4));
+  project_boundary_edges(g4, 2, onto_sphere<3>(Vec<3>::Zero(), L));
+  CHECK_THROWS_WITH((scenes::Jeffery3D{.cells_per_turn = -1}.mesh()), Catch::Contains("cells_per_turn"));
   // bad input, named
   const auto h = [](const Vec<3>&) { return 0.2; };
   CHECK_THROWS_WITH(gmsh_ellipsoid_in_sphere_mesh(1.4, s, h), Catch::Contains("radius"));

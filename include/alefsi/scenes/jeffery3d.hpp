@@ -46,6 +46,10 @@ struct Jeffery3D {
   Real h_body = 0.05;     ///< mesh size at the spheroid
   Real h_far = 1;         ///< largest mesh size
   Real grading = 0.3;     ///< growth of the size with the distance from the sphere of radius max(a, b)
+  /// Where the spheroid turns sharply (a slender one's tips), the size at its surface is at most
+  /// 2 pi rho / cells_per_turn, rho the smallest radius of curvature there, growing by `grading`
+  /// away from it: a curved cell has to be small beside the curve it follows. 0: h_body alone.
+  Real cells_per_turn = 16;
   bool curved = true;     ///< isoparametric P2 cells on the spheroid and the container
   GmshMeshOptions mesher{};  ///< gmsh's options (quality floor, Netgen optimiser)
 
@@ -59,6 +63,8 @@ struct Jeffery3D {
                      container);
     ALEFSI_CHECK_ARG(h_body > 0 && h_far >= h_body && grading > 0, "h_body, h_far, grading",
                      "need 0 < h_body <= h_far and grading > 0");
+    ALEFSI_CHECK_ARG(cells_per_turn >= 0 && std::isfinite(cells_per_turn), "cells_per_turn",
+                     "must be >= 0 (0: no refinement by curvature), got ", cells_per_turn);
   }
 
   /// The semi-axes in the mesh's axes (the symmetry axis along x).
@@ -67,10 +73,30 @@ struct Jeffery3D {
   /// The container with the spheroid, its axis along x (gmsh; `report`: cells, quality, time).
   Mesh<3> mesh(GmshMeshReport* report = nullptr) const {
     validate();
-    const auto size = [s = *this](const Vec<3>& x) {
-      return std::min(s.h_far, s.h_body + s.grading * std::max(Real(0), x.norm() - std::max(s.a, s.b)));
-    };
-    return gmsh_ellipsoid_in_sphere_mesh(container, semi_axes(), size, mesher, report, 1, 2);
+    return gmsh_ellipsoid_in_sphere_mesh(
+        container, semi_axes(), [s = *this](const Vec<3>& x) { return s.size(x); }, mesher, report, 1, 2);
+  }
+
+  /// The mesh size at x: h_body growing by `grading` with the distance from the sphere of
+  /// radius max(a, b), capped by h_far and by the curvature's size (`cells_per_turn`) at the
+  /// point of the spheroid on x's ray, growing by `grading` with the distance along the ray.
+  Real size(const Vec<3>& x) const {
+    Real h = std::min(h_far, h_body + grading * std::max(Real(0), x.norm() - std::max(a, b)));
+    if (cells_per_turn > 0 && x.norm() > 0) {
+      const Vec<3> y = onto_ellipsoid<3>(Vec<3>::Zero(), semi_axes())(x);
+      const Real h_turn = 2 * std::numbers::pi * curvature_radius(y) / cells_per_turn;
+      h = std::min(h, h_turn + grading * std::max(Real(0), x.norm() - y.norm()));
+    }
+    return h;
+  }
+
+  /// The smaller principal radius of curvature of the spheroid at its surface point y. On the
+  /// meridian (a cos t, b sin t): q = (a^2 sin^2 t + b^2 cos^2 t)^{1/2}, the meridian's radius
+  /// q^3 / (a b), the parallel's b q / a; both b^2 / a at the tips.
+  Real curvature_radius(const Vec<3>& y) const {
+    const Real c = std::clamp(y[0] / a, Real(-1), Real(1));
+    const Real q = std::sqrt(a * a * (1 - c * c) + b * b * c * c);
+    return std::min(q * q * q / (a * b), b * q / a);
   }
 
   /// The simple shear u = (gamma y, 0, 0) as a velocity gradient.

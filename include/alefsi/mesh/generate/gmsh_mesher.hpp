@@ -367,7 +367,7 @@ inline Mesh<3> gmsh_box_mesh(const BoxDomain& box, const std::vector<Sphere>& sp
 /// A mesh of the ball |x| < `radius` minus the ellipsoid sum (x_i / semi_axes_i)^2 < 1 (both
 /// about the origin, the ellipsoid's axes along the coordinate axes), with edge lengths near
 /// `size`: the ellipsoid's facets tagged `body_tag`, the sphere's `container_tag`, every node of
-/// the sphere on it and every node of the ellipsoid on it (radial projection, `onto_ellipsoid`).
+/// the sphere on it and every node of the ellipsoid on it (the nearest point, `onto_ellipsoid`).
 /// A body turned in a flow is the flow turned about the body (scenes/jeffery3d.hpp). The
 /// ellipsoid is OpenCASCADE's unit sphere stretched, whose parametrisation has its poles on z;
 /// when gmsh's surface mesher fails on it (a slender spheroid along x: b / a = 0.33 and below

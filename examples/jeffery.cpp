@@ -3,14 +3,17 @@
 // What it shows: a non-circular body (the built-in mesher's `Ellipse` hole) on isoparametric P2
 // cells, a free (massless) body in Stokes flow, and a result checked against a closed form.
 //
-// How to run:   ./jeffery [--aspect 2] [--container 32] [--angles 16] [--no-curved] [--output DIR]
-//   (`--help` lists the options with their defaults).
+// How to run:   ./jeffery [--aspect 2] [--container 32] [--angles 16] [--follow 40] [--no-curved]
+//   [--output DIR]   (`--help` lists the options with their defaults).
 // What it prints: the ellipse's spin w_h(phi) at `angles` orientations in [0, pi) beside
 //   Jeffery's w(phi) = -(a^2 sin^2 phi + b^2 cos^2 phi) / (a^2 + b^2) (shear rate 1), the period
 //   T_h = integral of d phi / |w_h| over a turn (trapezoidal rule: spectral for this periodic
 //   integrand) against T_J = 2 pi (a^2 + b^2) / (a b), and the largest gap between the angle
 //   phi_h(t), integrated from w_h (RK4 on its trigonometric interpolant), and Jeffery's
-//   phi(t) over one turn. It writes DIR/jeffery.csv (t, phi_h, phi_J).
+//   phi(t) over one turn. It writes DIR/jeffery.csv (t, phi_h, phi_J). With --follow N it then
+//   follows the ellipse in time on a moving mesh for a quarter period, from broadside to aligned,
+//   in N steps (Jeffery::follow_orbit), against the orbit of its own spins w_h(0), w_h(pi/2)
+//   (exact in a circular container) and Jeffery's; DIR/jeffery_time.csv (t, phi_h, both orbits).
 // Expected (measured, aspect 2, container 32, 16 angles, ~9,400 nodes, 23-33 s CPU): w_h within
 //   5.4e-4 of Jeffery's (w(pi/4) = -1/2 to 5e-7), T_h / T_J - 1 = 1.01e-3: the container's
 //   O((a / L)^2) reflection of the stresslet ((T_h / T_J - 1) (L / a)^2 = 1.03-1.06 for L = 8..64;
@@ -35,17 +38,19 @@ using std::numbers::pi;
 int main(int argc, char** argv) try {
   std::filesystem::path out = "output";
   Real aspect = 2, container = 32;
-  int angles = 16;
+  int angles = 16, follow = 0;
   bool curved = true;
   Options opt("jeffery", "A free ellipse in simple shear (Stokes): its spin, period and angle against Jeffery's orbit.");
   opt.add("aspect", aspect, "aspect ratio a / b of the ellipse (a = 1)")
       .add("container", container, "radius of the circular container (its wall moves with the shear)")
       .add("angles", angles, "number of orientations in [0, pi) at which the spin is solved")
+      .add("follow", follow, "steps of a quarter period followed in time on a moving mesh (0: none)")
       .flag("curved", curved, "isoparametric P2 cells on the ellipse and the container (--no-curved: polygons)")
       .add("output", out, "folder for jeffery.csv");
   if (!opt.parse(argc, argv, std::cout)) return 0;
   ALEFSI_CHECK_ARG(aspect >= 1 && std::isfinite(aspect), "--aspect", "must be >= 1, got ", aspect);
   ALEFSI_CHECK_ARG(angles >= 4 && angles % 2 == 0, "--angles", "must be even and >= 4, got ", angles);
+  ALEFSI_CHECK_ARG(follow >= 0, "--follow", "must be >= 0, got ", follow);
   opt.print(std::cout);
   scenes::Jeffery scene{.b = 1 / aspect, .container = container, .h_body = 0.1 / aspect, .curved = curved};
   scene.validate();
@@ -104,6 +109,29 @@ int main(int argc, char** argv) try {
             << " (Jeffery " << Tj << ", relative difference " << std::scientific << std::setprecision(2) << T / Tj - 1
             << "); angle within " << gap << " rad of Jeffery's over the turn; " << std::fixed << std::setprecision(1)
             << cpu << " s CPU for " << angles << " solves\nwrote " << (out / "jeffery.csv").string() << "\n";
+
+  // --- followed in time: a quarter period from broadside, on a moving mesh ------------------
+  if (follow > 0) {
+    const std::clock_t c1 = std::clock();
+    const Real w0 = w[0], w90 = w[std::size_t(angles / 2)], T4 = Tj / 4;
+    const Real wj0 = scene.jeffery_spin(0), wj90 = scene.jeffery_spin(pi / 2);
+    std::ofstream tcsv(out / "jeffery_time.csv");
+    tcsv << "t,phi_h,phi_orbit,phi_jeffery\n" << std::setprecision(12);
+    Real gap_own = 0, gap_j = 0, worst = 1;
+    scene.follow_orbit(pi / 2, T4 / follow, T4, [&](Real t, Real phi_t, Real q) {
+      const Real own = scenes::Jeffery::orbit_angle(t, pi / 2, w0, w90);
+      const Real jef = scenes::Jeffery::orbit_angle(t, pi / 2, wj0, wj90);
+      gap_own = std::max(gap_own, std::abs(phi_t - own)), gap_j = std::max(gap_j, std::abs(phi_t - jef));
+      worst = std::min(worst, q);
+      tcsv << t << "," << phi_t << "," << own << "," << jef << "\n";
+    });
+    std::cout << std::scientific << std::setprecision(2) << "followed in time (" << follow << " steps of "
+              << T4 / follow << ", a quarter period): angle within " << gap_own
+              << " rad of the orbit of w_h(0), w_h(pi/2) and " << gap_j << " of Jeffery's; worst quality "
+              << std::fixed << std::setprecision(3) << worst << "; " << std::setprecision(1)
+              << Real(std::clock() - c1) / CLOCKS_PER_SEC << " s CPU\nwrote " << (out / "jeffery_time.csv").string()
+              << "\n";
+  }
   return 0;
 } catch (const std::exception& e) {
   std::cerr << "jeffery: " << e.what() << "\n";

@@ -13,7 +13,8 @@
 //   phi(t) over one turn. It writes DIR/jeffery.csv (t, phi_h, phi_J). With --follow N it then
 //   follows the ellipse in time on a moving mesh for a quarter period, from broadside to aligned,
 //   in N steps (Jeffery::follow_orbit), against the orbit of its own spins w_h(0), w_h(pi/2)
-//   (exact in a circular container) and Jeffery's; DIR/jeffery_time.csv (t, phi_h, both orbits).
+//   (the form is exact in a circular container; the discrete spins follow it to 5e-7) and
+//   Jeffery's; DIR/jeffery_time.csv (t, phi_h, both orbits).
 // Expected (measured, aspect 2, container 32, 16 angles, ~9,400 nodes, 23-33 s CPU): w_h within
 //   5.4e-4 of Jeffery's (w(pi/4) = -1/2 to 5e-7), T_h / T_J - 1 = 1.01e-3: the container's
 //   O((a / L)^2) reflection of the stresslet ((T_h / T_J - 1) (L / a)^2 = 1.03-1.06 for L = 8..64;

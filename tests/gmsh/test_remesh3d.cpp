@@ -237,6 +237,13 @@ TEST_CASE("gmsh_ellipsoid_in_sphere_mesh: both surfaces exact and tagged, their 
   QuadraticGeometry<3> g4(m4);
   project_boundary_edges(g4, 1, onto_ellipsoid<3>(Vec<3>::Zero(), s4));
   project_boundary_edges(g4, 2, onto_sphere<3>(Vec<3>::Zero(), L));
+  // without the curvature's size (h_body 0.07 at tips of radius 0.0625) the cells curve too, by
+  // the nearest point; the radial projection folded one (cell 47707: det J ratio 0.078)
+  scenes::Jeffery3D coarse_tips = slender;
+  coarse_tips.cells_per_turn = 0;
+  const Mesh<3> m4c = coarse_tips.mesh();
+  QuadraticGeometry<3> g4c(m4c);
+  project_boundary_edges(g4c, 1, onto_ellipsoid<3>(Vec<3>::Zero(), s4));
   CHECK_THROWS_WITH((scenes::Jeffery3D{.cells_per_turn = -1}.mesh()), Catch::Contains("cells_per_turn"));
   // bad input, named
   const auto h = [](const Vec<3>&) { return 0.2; };

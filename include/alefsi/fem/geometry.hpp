@@ -307,9 +307,10 @@ auto onto_sphere(const Vec<D>& centre, Real radius) {
 /// critical points). A curved edge's point has to move along the normal: a radial projection
 /// moves the midpoint of a chord of a slender body along it as well, by as much as the chord's
 /// sagitta over the cosine between the ray and the normal, and that tangential part folds the
-/// cells beside it. Deep inside, where the root is not in that range (x on a thin body's axis
-/// farther than a radius of curvature from the tip), the radial projection is returned: the
-/// nearest point is not unique there. Undefined at the centre.
+/// cells beside it. Deep inside, where the root is not in that range (near the part of the
+/// plane of the larger axes whose points have no unique nearest point: on a prolate
+/// spheroid's axis farther than a radius of curvature from the tips), the radial projection is
+/// returned. Undefined at the centre.
 template <int D>
 auto onto_ellipsoid(const Vec<D>& centre, const Vec<D>& semi_axes) {
   ALEFSI_CHECK_ARG(semi_axes.minCoeff() > 0 && semi_axes.allFinite(), "semi_axes", "must be positive and finite");
@@ -337,11 +338,12 @@ auto onto_ellipsoid(const Vec<D>& centre, const Vec<D>& semi_axes) {
       const Real v = f(t, &df);
       if (v == 0) break;
       (v > 0 ? lo : hi) = t;
-      Real tn = t - v / df;                   // Newton,
-      if (!(tn > lo && tn < hi)) tn = (lo + hi) / 2;  // kept in the bracket by bisection
-      const bool done = std::abs(tn - t) <= 1e-14 * s2.maxCoeff();
-      t = tn;
-      if (done) break;
+      const Real step = v / df;
+      if (std::abs(step) <= 1e-14 * s2.maxCoeff()) {  // converged (before the safeguard: at the
+        t -= step;                                     // root, round-off may put t - step outside)
+        break;
+      }
+      t = t - step > lo && t - step < hi ? t - step : (lo + hi) / 2;  // Newton, kept in the bracket
     }
     const Vec<D> y = s2.cwiseProduct(d).cwiseQuotient((s2.array() + t).matrix());
     return Vec<D>(centre + y / y.cwiseQuotient(s).norm());  // on the surface to round-off

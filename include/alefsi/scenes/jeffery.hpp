@@ -77,8 +77,8 @@ struct Jeffery {
     return flow.body_velocity(0)[2];
   }
 
-  /// The ellipse followed in time on a moving mesh: a quasi-static flow (rho = 1e-18) stepped
-  /// by dt to t_end from the orientation phi0, the body free and massless, the mesh moved by
+  /// The ellipse followed in time on a moving mesh: a quasi-static flow (rho = 1e-18), from the
+  /// orientation phi0, round(t_end / dt) steps of dt, the body free and massless, the mesh moved by
   /// elasticity, the curved edge points carried rigidly with the body. The start is consistent:
   /// the body spins at once at spin(phi0) (from rest, the first explicit position update would
   /// lag the orbit by dt w). `visit(t, phi, worst_quality)` after every step. Without remeshing
@@ -110,8 +110,10 @@ struct Jeffery {
 
   /// The orbit of d phi / dt = w0 cos^2 phi + w1 sin^2 phi (w0, w1 < 0: the spins at phi = 0
   /// and pi / 2) from phi(0) = phi0, continuous in t. In a circular container the spin has this
-  /// form exactly, so with w0 = spin(0), w1 = spin(pi / 2) it is the discrete problem's own
-  /// orbit (Jeffery's with w0 = -b^2 / (a^2 + b^2), w1 = -a^2 / (a^2 + b^2)):
+  /// form exactly; the discrete spins, each on its own mesh, follow it to 5e-7 (w(pi / 4),
+  /// w(pi / 8): docs/results.md), so with w0 = spin(0), w1 = spin(pi / 2) it is the discrete
+  /// problem's own orbit to that accuracy (Jeffery's with w0 = -b^2 / (a^2 + b^2),
+  /// w1 = -a^2 / (a^2 + b^2)):
   ///     tan phi = (B / A)^{1/2} tan theta,  theta = theta0 - (A B)^{1/2} t,  A = -w1, B = -w0.
   static Real orbit_angle(Real t, Real phi0, Real w0, Real w1) {
     ALEFSI_CHECK_ARG(w0 < 0 && w1 < 0, "w0, w1", "the spins must be negative (shear along +x), got ", w0, ", ", w1);

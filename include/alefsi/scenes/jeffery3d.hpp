@@ -47,8 +47,9 @@ struct Jeffery3D {
   Real h_far = 1;         ///< largest mesh size
   Real grading = 0.3;     ///< growth of the size with the distance from the sphere of radius max(a, b)
   /// Where the spheroid turns sharply (a slender one's tips), the size at its surface is at most
-  /// 2 pi rho / cells_per_turn, rho the smallest radius of curvature there, growing by `grading`
-  /// away from it: a curved cell has to be small beside the curve it follows. 0: h_body alone.
+  /// 2 pi rho / cells_per_turn, rho the smaller principal radius of curvature there, growing by
+  /// `grading` away from it (`size`): a curved cell has to be small beside the curve it follows.
+  /// 0: h_body alone. At 16, b/a = 1/2 is refined at the tips only where h_body > 0.098.
   Real cells_per_turn = 16;
   bool curved = true;     ///< isoparametric P2 cells on the spheroid and the container
   GmshMeshOptions mesher{};  ///< gmsh's options (quality floor, Netgen optimiser)
@@ -78,8 +79,9 @@ struct Jeffery3D {
   }
 
   /// The mesh size at x: h_body growing by `grading` with the distance from the sphere of
-  /// radius max(a, b), capped by h_far and by the curvature's size (`cells_per_turn`) at the
-  /// point of the spheroid on x's ray, growing by `grading` with the distance along the ray.
+  /// radius max(a, b), capped by h_far and by the curvature's size (`cells_per_turn`) at y, the
+  /// nearest point of the spheroid, growing by `grading` with |x| - |y| (<= |x - y|: a little
+  /// finer than by the distance, and cheaper).
   Real size(const Vec<3>& x) const {
     Real h = std::min(h_far, h_body + grading * std::max(Real(0), x.norm() - std::max(a, b)));
     if (cells_per_turn > 0 && x.norm() > 0) {

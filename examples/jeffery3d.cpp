@@ -22,10 +22,11 @@
 //   lambda, the superposition check, T_h against T_J = 2 pi (r + 1 / r), the largest angle
 //   between the computed and Jeffery's axis over each orbit, and a summary line. It writes
 //   DIR/jeffery3d.csv (t, p_h, p_J for the off-plane orbit).
-// Expected (aspect 2, container 8, h-body 0.1: 42,600 cells, 240 s CPU, 1.5 GB): lambda_h 0.47 %
-//   above Jeffery's (the container's O((a / L)^3) and the mesh's parts), the other entries of K
-//   below 4e-5, the superposition to 1e-11, T_h / T_J - 1 = 2.7e-3; docs/results.md, "Jeffery's
-//   orbit".
+// Expected (aspect 2, container 8, h-body 0.1: 42,719 cells, about 240 s CPU, 1.5 GB): lambda_h
+//   0.46 % above Jeffery's (the container's O((a / L)^3) and the mesh's parts), the other
+//   entries of K below 4e-5, the superposition to 1e-11, T_h / T_J - 1 = 2.6e-3. Aspect 4 at
+//   h-body 0.07: 96,297 cells, 4.1 GB, lambda_h 0.12 % above, T_h / T_J - 1 = 4.4e-3;
+//   docs/results.md, "Jeffery's law in 3D".
 #include <alefsi/alefsi.hpp>
 #include <alefsi/app.hpp>
 #include <alefsi/scenes/jeffery3d.hpp>

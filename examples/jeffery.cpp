@@ -109,7 +109,7 @@ int main(int argc, char** argv) try {
   }
   // in a circular container w = w(0) cos^2 + w(pi/2) sin^2 exactly: the period in closed form,
   // which the quadrature approaches only once the angles resolve a slender body's peaked 1 / |w|
-  const Real T_closed = 2 * pi / std::sqrt(w[0] * w[std::size_t(angles / 2)]);
+  const Real w0 = w[0], w90 = w[std::size_t(angles / 2)], T_closed = 2 * pi / std::sqrt(w0 * w90);
   std::cout << std::scientific << std::setprecision(3) << "period " << std::fixed << std::setprecision(5) << T
             << " (closed form from w_h(0), w_h(pi/2): " << T_closed << "; Jeffery " << Tj << ", relative differences "
             << std::scientific << std::setprecision(2) << T / Tj - 1 << ", " << T_closed / Tj - 1 << "); angle within "
@@ -119,7 +119,7 @@ int main(int argc, char** argv) try {
   // --- followed in time: a quarter period from broadside, on a moving mesh ------------------
   if (follow > 0) {
     const std::clock_t c1 = std::clock();
-    const Real w0 = w[0], w90 = w[std::size_t(angles / 2)], T4 = Tj / 4;
+    const Real T4 = Tj / 4;
     const Real wj0 = scene.jeffery_spin(0), wj90 = scene.jeffery_spin(pi / 2);
     std::ofstream tcsv(out / "jeffery_time.csv");
     tcsv << "t,phi_h,phi_orbit,phi_jeffery\n" << std::setprecision(12);

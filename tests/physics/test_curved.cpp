@@ -694,6 +694,7 @@ TEST_CASE("a free ellipse followed in time on a moving mesh: its angle converges
     CHECK(std::log2(err[k] / err[k + 1]) == Approx(2).margin(0.2));
   }
   CHECK_THROWS_WITH(scene.follow_orbit(0, 0, 1, [](Real, Real, Real) {}), Catch::Contains("dt"));
+  CHECK_THROWS_WITH(scenes::Jeffery::orbit_angle(1, 0, 0.2, -0.8), Catch::Contains("w0, w1"));
 }
 
 TEST_CASE("curved boundaries in a flow: what is refused, naming the parameter", "[curved][quick]") {

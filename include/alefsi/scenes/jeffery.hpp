@@ -36,6 +36,8 @@ struct Jeffery {
   Real grading = 0.25;        ///< growth of the size with the distance from the circle of radius a
   bool curved = true;         ///< isoparametric P2 cells on the ellipse and the container
 
+  using Flow = AleFlow<FlowConfig<2, TaylorHood, BDF2_BDF2E, UnsteadyStokes>>;
+
   void validate() const {
     ALEFSI_CHECK_ARG(a > 0 && b > 0 && std::isfinite(a) && std::isfinite(b), "a, b",
                      "semi-axes must be positive and finite, got ", a, ", ", b);
@@ -62,17 +64,9 @@ struct Jeffery {
   /// rho = 1e-18, one step of 1e-6 from rest: the rest mass term rho / dt = 1e-12 is far below
   /// the solution's accuracy), the body massless and free. `nodes`: the mesh's node count.
   Real spin(Real phi, Index* nodes = nullptr) const {
-    AleFlow<FlowConfig<2, TaylorHood, BDF2_BDF2E, UnsteadyStokes>> flow(mesh(phi), FlowOptions{1e-18, mu});
+    Flow flow(mesh(phi), FlowOptions{1e-18, mu});
     if (nodes) *nodes = flow.mesh().n_nodes();
-    flow.set_velocity(2, [g = gamma](const Vec<2>& x, Real) { return Vec<2>(g * x[1], 0); });
-    RigidBody2D body;
-    body.tag = 1;
-    body.angle = phi;
-    flow.add_body(body);
-    if (curved) {
-      flow.curve_boundary(1, [e = ellipse(phi)](const Vec<2>& x) { return e.radial_projection(x); });
-      flow.curve_boundary(2, onto_sphere<2>(Vec<2>::Zero(), container));
-    }
+    set_up(flow, phi, 0);
     flow.step(1e-6);
     return flow.body_velocity(0)[2];
   }
@@ -90,17 +84,8 @@ struct Jeffery {
     ALEFSI_CHECK_ARG(dt > 0 && t_end >= dt && std::isfinite(t_end), "dt, t_end", "need 0 < dt <= t_end, got ", dt,
                      ", ", t_end);
     const Real w0 = spin(phi0);
-    AleFlow<FlowConfig<2, TaylorHood, BDF2_BDF2E, UnsteadyStokes>> flow(mesh(phi0), FlowOptions{1e-18, mu});
-    flow.set_velocity(2, [g = gamma](const Vec<2>& x, Real) { return Vec<2>(g * x[1], 0); });
-    RigidBody2D body;
-    body.tag = 1;
-    body.angle = phi0;
-    body.velocity = Vec<3>(0, 0, w0);
-    flow.add_body(body);
-    if (curved) {
-      flow.curve_boundary(1, [e = ellipse(phi0)](const Vec<2>& x) { return e.radial_projection(x); });
-      flow.curve_boundary(2, onto_sphere<2>(Vec<2>::Zero(), container));
-    }
+    Flow flow(mesh(phi0), FlowOptions{1e-18, mu});
+    set_up(flow, phi0, w0);
     const long n = std::lround(t_end / dt);
     for (long i = 0; i < n; ++i) {
       flow.step(dt);
@@ -125,6 +110,21 @@ struct Jeffery {
     };
     const Real theta = turn(phi0, std::sqrt(B), std::sqrt(A)) - std::sqrt(A * B) * t;
     return turn(theta, std::sqrt(A), std::sqrt(B));
+  }
+
+  /// The scene on `flow` (a mesh of `mesh(phi)`): the container's wall in the shear, the free,
+  /// massless ellipse at orientation phi spinning at `spin0`, the curved boundaries.
+  void set_up(Flow& flow, Real phi, Real spin0) const {
+    flow.set_velocity(2, [g = gamma](const Vec<2>& x, Real) { return Vec<2>(g * x[1], 0); });
+    RigidBody2D body;
+    body.tag = 1;
+    body.angle = phi;
+    body.velocity = Vec<3>(0, 0, spin0);
+    flow.add_body(body);
+    if (curved) {
+      flow.curve_boundary(1, [e = ellipse(phi)](const Vec<2>& x) { return e.radial_projection(x); });
+      flow.curve_boundary(2, onto_sphere<2>(Vec<2>::Zero(), container));
+    }
   }
 
   /// Jeffery's spin at orientation phi (unbounded flow).

@@ -83,11 +83,12 @@ struct Jeffery3D {
   /// nearest point of the spheroid, growing by `grading` with |x| - |y| (<= |x - y|: a little
   /// finer than by the distance, and cheaper).
   Real size(const Vec<3>& x) const {
-    Real h = std::min(h_far, h_body + grading * std::max(Real(0), x.norm() - std::max(a, b)));
-    if (cells_per_turn > 0 && x.norm() > 0) {
+    const Real r = x.norm();
+    Real h = std::min(h_far, h_body + grading * std::max(Real(0), r - std::max(a, b)));
+    if (cells_per_turn > 0 && r > 0) {
       const Vec<3> y = onto_ellipsoid<3>(Vec<3>::Zero(), semi_axes())(x);
       const Real h_turn = 2 * std::numbers::pi * curvature_radius(y) / cells_per_turn;
-      h = std::min(h, h_turn + grading * std::max(Real(0), x.norm() - y.norm()));
+      h = std::min(h, h_turn + grading * std::max(Real(0), r - y.norm()));
     }
     return h;
   }

@@ -8,8 +8,8 @@
 // level), graded by 0.25 to min(8 h_body, 10 mm)); each position twice, with the caps removed
 // (the default) and kept.
 //
-//   cmake --build build/release --target gmsh_caps
-//   build/release/bench/gmsh_caps [level] [positions]      (defaults 2 and 40)
+//   cmake --preset bench && cmake --build build/bench --target gmsh_caps
+//   build/bench/bench/gmsh_caps [level] [positions]      (defaults 2 and 40)
 //
 // Prints per position the cells and worst quality with and without the caps and the caps
 // removed, then a summary line (how many meshes fall below quality 0.15, the worst of each).

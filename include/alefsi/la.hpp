@@ -7,6 +7,7 @@
 /// its AMG (la/amg.hpp). They added about 3.5 s to every translation unit that includes them
 /// (docs/performance.md, compile time), so a program includes them where it uses them.
 #include "alefsi/la/assembler.hpp"
+#include "alefsi/la/coupling.hpp"
 #include "alefsi/la/linear_solve.hpp"
 #include "alefsi/la/ordering.hpp"
 #include "alefsi/la/saddle_point_blocks.hpp"

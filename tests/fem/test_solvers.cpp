@@ -143,6 +143,58 @@ TEST_CASE("factorisation reuse: GMRES on an earlier matrix's factors solves late
   CHECK(c1.krylov_iterations == c2.krylov_iterations);
 }
 
+TEST_CASE("a coupling beside the pattern: LinearSolve solves (J + C) x = r on J's factors, fresh or kept, in at most "
+          "rank(C) + 1 GMRES iterations when fresh",
+          "[la][solvers][reuse][quick]") {
+  const LinearSystem s = stokes_system<TaylorHood>(8);
+  const Index n = s.A.rows();
+  // a dense 6 x 6 block of rank 2 on six velocity unknowns spread over the system
+  BlockCoupling C;
+  C.index = {3, 4, 40, 41, 90, 91};
+  VecX a(6), b(6);
+  a << 1, -2, 0.5, 3, -1, 2;
+  b << 0.3, 1, -0.7, 0.2, 0.5, -1;
+  C.block = 2.0 * a * b.transpose() + 1.5 * b * a.transpose();
+  auto with_c = [&](const SparseMatrix& A) {  // J + C assembled, for the reference solve
+    SparseMatrix S = A;
+    for (Index i = 0; i < 6; ++i)
+      for (Index j = 0; j < 6; ++j) S.coeffRef(C.index[std::size_t(i)], C.index[std::size_t(j)]) += C.block(i, j);
+    S.makeCompressed();
+    return S;
+  };
+  const VecX reference = solve_with<SparseLu<>>(with_c(s.A), s.b);
+  // the operator
+  const VecX x0 = VecX::LinSpaced(n, -1, 1);
+  CHECK(((CoupledMatrix<SparseMatrix>{s.A, C} * x0) - with_c(s.A) * x0).norm() <= 1e-14 * (s.A * x0).norm());
+  for (bool reuse : {false, true}) {
+    LinearSolve<SparseLu<>> lin;
+    lin.set_reuse({.enabled = reuse});
+    lin.set_coupling(&C);
+    LinearSolveCounts counts;
+    lin.factorize(s.A);
+    ++counts.factorisations;
+    const VecX x = lin.solve(s.A, s.b, counts);
+    INFO("reuse " << reuse << ": GMRES iterations " << counts.krylov_iterations);
+    CHECK(relative_residual(with_c(s.A), x, s.b) < 1e-12);
+    CHECK((x - reference).norm() <= 1e-10 * reference.norm());
+    CHECK(counts.krylov_iterations <= 2 + 1);  // rank(C) + 1
+    CHECK(counts.factorisations == 1);
+    if (reuse) {  // a later matrix on the kept factors
+      SparseMatrix A = s.A;
+      for (Index k = 0; k < 20; ++k) A.coeffRef(k, k) *= 1.001;
+      REQUIRE(lin.reusable());
+      const VecX y = lin.solve(A, s.b, counts);
+      CHECK(relative_residual(with_c(A), y, s.b) < 1e-12);
+      CHECK(counts.reused == 1);
+      CHECK(counts.factorisations == 1);
+    }
+    // without the coupling, J alone
+    lin.set_coupling(nullptr);
+    lin.factorize(s.A);
+    CHECK(relative_residual(s.A, lin.solve(s.A, s.b, counts), s.b) < 1e-13);
+  }
+}
+
 TEST_CASE("Eigen's AMDOrdering convention; the SparseLU orderings are the right way round", "[la][solvers][quick]") {
   // arrowhead: unknown 0 is coupled to every other one, so AMD eliminates it last
   const Index n = 6;

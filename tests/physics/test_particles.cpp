@@ -4,6 +4,7 @@
 // (disks, an ellipse).
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -252,6 +253,49 @@ TEST_CASE("DKT, coarse: drafting brings the disks together, the collision forces
   CHECK(s.worst_quality > 0.05);  // never a degenerate cell
   // drafting and kissing: from 0.5 apart to within the spring's range (0.25 + 0.08)
   CHECK(closest < 2 * 0.125 + 0.08);
+}
+
+TEST_CASE("Newton in contact: with the coupling between the two bodies' rows it converges as without contact; "
+          "lagged, linearly, to the same solution",
+          "[collision][quick]") {
+  // two disks 0.06 apart closing at 0.2 (a lubrication coefficient mu (4 Rbar / d)^{3/2} = 2.4
+  // against a disk's mass per step m / dt = 5.9), Taylor–Hood, BDF2, Newton to 1e-10
+  const Real R = 0.25;
+  const std::vector<Circle> disks = {{Vec<2>(0.7, 1), R, 5}, {Vec<2>(1.26, 1.0), R, 6}};
+  const CollisionOptions opt{.range = 0.6, .spring_range = 0.02, .spring_force = 1};
+  using Flow = AleFlow<FlowConfig<2, TaylorHood, BDF2_BDF2E>>;
+  auto run = [&](bool coupled, std::vector<int>& iterations) {
+    Flow flow(channel_with_disks(2, 2, disks, 0.05, 0.3),
+              {.rho = 1, .mu = 0.1, .linearisation = Linearisation::newton, .max_newton = 100, .newton_tolerance = 1e-10});
+    for (int t = 1; t <= 4; ++t) flow.set_velocity(t, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });
+    for (const auto& c : disks) {
+      RigidBody2D b = disk_body(c.tag, c.centre, R, 1.5);
+      b.velocity << (c.tag == 5 ? 0.1 : -0.1), 0, 0;
+      flow.add_body(b);
+    }
+    if (coupled) flow.set_collisions(opt);
+    else flow.set_contact_model(std::make_unique<LaggedPairCoupling<2>>(DefaultContact<2>::collisions(opt)));
+    for (int n = 0; n < 3; ++n) {
+      const StepReport rep = flow.step(0.05);
+      REQUIRE(flow.stats().contacts == 1);
+      iterations.push_back(rep.newton_iterations);
+    }
+    return std::array<Vec<3>, 2>{flow.body_velocity(0), flow.body_velocity(1)};
+  };
+  std::vector<int> coupled_its, lagged_its;
+  const auto coupled = run(true, coupled_its);
+  const auto lagged = run(false, lagged_its);
+  INFO("Newton iterations per step, coupled " << coupled_its[0] << " " << coupled_its[1] << " " << coupled_its[2]
+                                              << ", lagged " << lagged_its[0] << " " << lagged_its[1] << " "
+                                              << lagged_its[2]);
+  for (int k = 0; k < 2; ++k) {
+    INFO("body " << k << ": velocity " << coupled[k].transpose() << ", difference " << (coupled[k] - lagged[k]).norm());
+    CHECK((coupled[k] - lagged[k]).norm() <= 1e-9 * 0.1);  // the initial speed
+  }
+  for (int n = 0; n < 3; ++n) {
+    CHECK(coupled_its[std::size_t(n)] <= 4);
+    CHECK(lagged_its[std::size_t(n)] > coupled_its[std::size_t(n)]);
+  }
 }
 
 TEST_CASE("Remesher2D: the size function sees a disk's circle and any other body's bounding circle",

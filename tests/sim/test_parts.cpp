@@ -98,31 +98,40 @@ void check_body_jacobian(const Space& space, Bodies& bodies, States& states, con
   const Index n = cons.n_unknowns();
   VecX u = VecX::Zero(n);
   for (Index i = 0; i < n; ++i) u[i] = 0.3 * std::sin(1.7 * i + 0.4);
+  BlockCoupling C;  // the blocks between two bodies (beside the pattern)
   auto rows = [&](const VecX& uu, SparseMatrix& J) {
     VecX r = VecX::Zero(n);
     J.resize(n, n);
     J.setZero();
-    bodies.add_rows(states, c, cons, uu, r, J, g, contact, 0.1);
+    bodies.add_rows(states, c, cons, uu, r, J, g, contact, 0.1, nullptr, &C);
     return r;
   };
   SparseMatrix J;
   const VecX r = rows(u, J);
+  // the Jacobian among the bodies' unknowns (all free here, after the flow's): J's and C's
   constexpr int nd = Bodies::n_dof;
-  Real worst = 0;
-  for (std::size_t b = 0; b < bodies.size(); ++b) {
-    const Index e0 = cons.n_free() + Index(b) * nd;  // bodies are all free here
-    for (int j = 0; j < nd; ++j) {
-      const Real h = 1e-6;
-      VecX up = u, um = u;
-      up[e0 + j] += h, um[e0 + j] -= h;
-      SparseMatrix Jp;
-      const VecX fd = (rows(up, Jp) - rows(um, Jp)) / (2 * h);
-      for (int i = 0; i < nd; ++i) worst = std::max(worst, std::abs(J.coeff(e0 + i, e0 + j) - fd[e0 + i]) / (1 + std::abs(fd[e0 + i])));
+  const Index e0 = cons.n_free(), ne = Index(bodies.size()) * nd;
+  MatX Jb = MatX(J.block(e0, e0, ne, ne));
+  for (Index a = 0; a < C.size(); ++a)
+    for (Index b = 0; b < C.size(); ++b) Jb(C.index[std::size_t(a)] - e0, C.index[std::size_t(b)] - e0) += C.block(a, b);
+  const BlockCoupling C0 = C;
+  Real worst = 0, coupled = 0;  // coupled: the largest derivative of one body's rows in another's velocity
+  for (Index j = 0; j < ne; ++j) {
+    const Real h = 1e-6;
+    VecX up = u, um = u;
+    up[e0 + j] += h, um[e0 + j] -= h;
+    SparseMatrix Jp;
+    const VecX fd = VecX((rows(up, Jp) - rows(um, Jp)) / (2 * h)).segment(e0, ne);
+    for (Index i = 0; i < ne; ++i) {
+      worst = std::max(worst, std::abs(Jb(i, j) - fd[i]) / (1 + std::abs(fd[i])));
+      if (i / nd != j / nd) coupled = std::max(coupled, std::abs(fd[i]));
     }
   }
-  INFO(D << "D worst relative difference of the body blocks " << worst);
+  INFO(D << "D worst relative difference of the bodies' Jacobian " << worst << ", coupling " << coupled);
   CHECK(worst < 1e-7);
   CHECK(r.allFinite());
+  // a contact between two bodies puts its coupling beside the pattern, and nothing else does
+  CHECK((C0.size() > 0) == (coupled > 0));
 }
 }  // namespace
 
@@ -333,7 +342,7 @@ TEST_CASE("CollisionContact2D: eq. (24) + spring through the seam, momentum bala
   const std::vector<Vec<2>> v = {Vec<2>(0, 3), Vec<2>(0, -2)};
   std::vector<Vec<2>> F(2, Vec<2>::Zero());
   int visits = 0;
-  model.forces(v, [&](int k, const Vec<2>& f, const Mat<2>&, const Vec<2>& arm) {
+  model.forces(v, [&](int k, const Vec<2>& f, const Mat<2>&, const Vec<2>& arm, int) {
     F[k] += f, ++visits;
     CHECK(arm.norm() == 0.0);  // disks: through the centres
   });
@@ -397,7 +406,7 @@ TEST_CASE("CollisionContact<3>: spheres in a box through the seam, momentum bala
   const std::vector<Vec<3>> v = {Vec<3>(0.1, 0, -0.4), Vec<3>(-0.2, 0.1, -1)};
   std::vector<Vec<3>> F(2, Vec<3>::Zero());
   std::vector<Mat<3>> dF(2, Mat<3>::Zero());
-  model.forces(v, [&](int k, const Vec<3>& f, const Mat<3>& df, const Vec<3>& arm) {
+  model.forces(v, [&](int k, const Vec<3>& f, const Mat<3>& df, const Vec<3>& arm, int) {
     F[k] += f, dF[k] += df;
     CHECK(arm.norm() == 0.0);  // spheres: through the centres
   });
@@ -415,8 +424,8 @@ TEST_CASE("CollisionContact<3>: spheres in a box through the seam, momentum bala
       auto vp = v, vm = v;
       vp[k][j] += h, vm[k][j] -= h;
       Vec<3> fp = Vec<3>::Zero(), fm = Vec<3>::Zero();
-      model.forces(vp, [&](int i, const Vec<3>& f, const Mat<3>&, const Vec<3>&) { if (i == k) fp += f; });
-      model.forces(vm, [&](int i, const Vec<3>& f, const Mat<3>&, const Vec<3>&) { if (i == k) fm += f; });
+      model.forces(vp, [&](int i, const Vec<3>& f, const Mat<3>&, const Vec<3>&, int) { if (i == k) fp += f; });
+      model.forces(vm, [&](int i, const Vec<3>& f, const Mat<3>&, const Vec<3>&, int) { if (i == k) fm += f; });
       for (int i = 0; i < 3; ++i) CHECK(dF[k](i, j) == Approx((fp[i] - fm[i]) / (2 * h)).epsilon(1e-6).margin(1e-5));
     }
   // overlaps, gaps, and times to contact

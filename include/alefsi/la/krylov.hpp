@@ -54,6 +54,9 @@
 /// ||b - K x|| <= tolerance ||b|| and throws `SolverError` when `max_iterations` are spent.
 /// Lifetime: `solve` multiplies by the matrix given to `factorize`, which must stay alive and
 /// unchanged until the last `solve` (as for UmfPackLu).
+/// `set_coupling(C)` (la/coupling.hpp): entries among the extra unknowns that A's pattern lacks
+/// (two bodies in contact); the solves are then with A + C, and the set-up's exact elimination
+/// of the extra unknowns includes C (the values it had at the set-up).
 ///
 ///     alefsi::SaddlePointGmres<3> krylov({.tolerance = 1e-10});
 ///     krylov.set_blocks(alefsi::saddle_point_blocks(space, cons, mu));   // optional
@@ -72,6 +75,7 @@
 #include "alefsi/fem/quadrature.hpp"
 #include "alefsi/la/amg.hpp"
 #include "alefsi/la/gmres.hpp"
+#include "alefsi/la/coupling.hpp"
 #include "alefsi/la/saddle_point_blocks.hpp"
 #include "alefsi/la/solvers.hpp"
 
@@ -119,6 +123,11 @@ class SaddlePointGmres {
   }
   bool pressure_null_space() const { return null_space_; }
 
+  /// Entries beside the matrix's pattern among the extra unknowns (la/coupling.hpp: a contact
+  /// between two bodies), null for none: the solves are with A + C, and the next set-up
+  /// eliminates the extra unknowns exactly with them. `c` must stay alive while it is set.
+  void set_coupling(const BlockCoupling* c) { coupling_ = c && !c->empty() ? c : nullptr; }
+
   /// Finds the split [u | p | z] (from the blocks, or from the diagonal's sign).
   void analyze(const SparseMatrix& A) {
     n_ = A.rows();
@@ -144,6 +153,9 @@ class SaddlePointGmres {
     if (!analyzed_ || A.rows() != n_) analyze(A);
     A_ = &A;
     const Index p0 = nu_, e0 = nu_ + np_;
+    if (coupling_)
+      ALEFSI_CHECK_ARG(coupling_->index.front() >= e0 && coupling_->index.back() < n_, "coupling",
+                       "must lie among the extra unknowns [", e0, ", ", n_, ")");
     RowSparseMatrix Ar = A;
     RowSparseMatrix Auu = Ar.topLeftCorner(nu_, nu_);
     amg_.compute(std::move(Auu), comp_);
@@ -155,7 +167,11 @@ class SaddlePointGmres {
       Azu_ = MatX(Ar.block(e0, 0, ne_, nu_));
       Y_.resize(nu_, ne_);
       for (Index k = 0; k < ne_; ++k) Y_.col(k) = velocity_solve(Auz.col(k));
-      const MatX Sz = MatX(Ar.block(e0, e0, ne_, ne_)) - Azu_ * Y_;
+      MatX Sz = MatX(Ar.block(e0, e0, ne_, ne_)) - Azu_ * Y_;
+      if (coupling_)  // entries beside the pattern (la/coupling.hpp): all among the extra unknowns
+        for (Index a = 0; a < coupling_->size(); ++a)
+          for (Index b = 0; b < coupling_->size(); ++b)
+            Sz(coupling_->index[std::size_t(a)] - e0, coupling_->index[std::size_t(b)] - e0) += coupling_->block(a, b);
       body_lu_.compute(Sz);
     }
     // Schur complement approximation
@@ -240,10 +256,14 @@ class SaddlePointGmres {
                             .restart = opt_.restart, .augment = opt_.augment};
     auto prec = [this](const VecX& v) { return precondition(v); };
     VecX x;
+    auto gmres_on = [&](const VecX& rhs, const GmresOptions& o) {
+      return coupling_ ? gmres(CoupledMatrix<SparseMatrix>{*A_, *coupling_}, rhs, prec, o, x, work_)
+                       : gmres(*A_, rhs, prec, o, x, work_);
+    };
     GmresResult res;
     defect_ = 0;
     if (!null_space_) {
-      res = gmres(*A_, b, prec, gopt, x, work_);
+      res = gmres_on(b, gopt);
     } else {
       // b without its component along e; the tolerance stays relative to ||b||
       VecX bc = b;
@@ -257,7 +277,7 @@ class SaddlePointGmres {
       } else {
         GmresOptions copt = gopt;
         copt.tolerance = opt_.tolerance * bn / cn;
-        res = gmres(*A_, bc, prec, copt, x, work_);
+        res = gmres_on(bc, copt);
         res.residual *= cn / bn;
       }
       x.segment(nu_, np_).array() -= x.segment(nu_, np_).mean();
@@ -359,6 +379,7 @@ class SaddlePointGmres {
   VecX schur_inv_diag_, mass_inv_diag_;
   Real cheb_lo_ = 0.5, cheb_hi_ = 2.5, mass_scale_ = 1;
   GmresWork work_;
+  const BlockCoupling* coupling_ = nullptr;  // non-empty, or null
   int iterations_ = 0;
   Real residual_ = 0, defect_ = 0;
 };

@@ -8,6 +8,10 @@
 /// `ReusableSetUp`: SaddlePointGmres) keeps its set-up likewise, until `drop()` (the flow drops
 /// it at every step: its Schur approximation holds the step's dt). The flow's
 /// Newton solve (sim/newton.hpp) and the mesh-velocity problem (physics/mesh_motion.hpp) use it.
+/// With a coupling (`set_coupling`, la/coupling.hpp: entries the pattern lacks) it solves
+/// (J + C) x = r: direct solvers by GMRES on J + C preconditioned by the factors of J (or of the
+/// earlier matrix kept), `SaddlePointGmres` with C in its operator; other iterative solvers
+/// solve J x = r (C lagged).
 ///
 ///     LinearSolve<SparseLu<>> lin;
 ///     lin.set_reuse({.enabled = true});
@@ -19,6 +23,7 @@
 
 #include "alefsi/core/eigen_sparse.hpp"
 #include "alefsi/core/error.hpp"
+#include "alefsi/la/coupling.hpp"
 #include "alefsi/la/gmres.hpp"
 #include "alefsi/la/solvers.hpp"
 
@@ -83,6 +88,13 @@ class LinearSolve {
     factored_ = false;
     analysed_values_.resize(0), factored_values_.resize(0);
   }
+  /// Entries beside J's pattern that the coming factorisations and solves include (null or
+  /// empty: none); the object must stay alive until it is unset. An iterative solver that takes
+  /// one (`set_coupling`) is handed it.
+  void set_coupling(const BlockCoupling* c) {
+    coupling_ = c && !c->empty() ? c : nullptr;
+    if constexpr (requires { solver_.set_coupling(c); }) solver_.set_coupling(coupling_);
+  }
   void factorize(const SparseMatrix& J) {
     // the matrices' values are kept for checkpoints (direct solvers: an iterative solver's
     // set-up is dropped at every step, so a checkpoint between steps has none)
@@ -102,6 +114,8 @@ class LinearSolve {
   /// Solves J x = r: directly after factorize(J); otherwise by GMRES preconditioned by the
   /// factors at hand, and, when that misses its tolerance in max_iterations, by factorising J.
   VecX solve(const SparseMatrix& J, const VecX& r, LinearSolveCounts& counts) {
+    if constexpr (DirectSolver<S>)
+      if (coupling_) return solve_coupled(J, r, counts);
     if (!fresh_ && reusable())
       if (std::optional<VecX> x = solve_on_kept(J, r, counts)) return std::move(*x);
     // the factors (set-up) of J: the fresh ones, or made now
@@ -165,6 +179,34 @@ class LinearSolve {
       return x;
     }
   }
+  // (J + C) x = r by GMRES on J + C preconditioned by the factors at hand: J's own (made now if
+  // need be), at most rank(C) + 1 iterations, or an earlier matrix's (reuse), as many more as
+  // the coupling's size. Fresh factors return GMRES's iterate even if round-off keeps it above
+  // the tolerance: its residual is no larger than that of J^-1 r, the lagged solve's.
+  VecX solve_coupled(const SparseMatrix& J, const VecX& r, LinearSolveCounts& counts) {
+    const BlockCoupling& C = *coupling_;
+    auto run = [&](int cap, VecX& x) {
+      const GmresResult res = gmres(
+          CoupledMatrix<SparseMatrix>{J, C}, r, [this](const VecX& v) { return VecX(solver_.solve(v)); },
+          {.tolerance = reuse_.tolerance, .max_iterations = cap, .restart = cap}, x, work_);
+      counts.krylov_iterations += res.iterations;
+      return res;
+    };
+    const int m = int(C.size());
+    VecX x;
+    if (!fresh_ && reusable()) {
+      const GmresResult res = run(reuse_.max_iterations + m, x);
+      if (res.converged) {
+        ++counts.reused;
+        refactor_next_ = res.iterations > reuse_.refactor_above + m;
+        return x;
+      }
+    }
+    if (!fresh_) factorize(J), ++counts.factorisations;
+    fresh_ = false;
+    run(m + 4, x);
+    return x;
+  }
   static VecX values(const SparseMatrix& J) { return Eigen::Map<const VecX>(J.valuePtr(), J.nonZeros()); }
 
   S solver_;
@@ -174,6 +216,7 @@ class LinearSolve {
   bool fresh_ = false;          // the factors are the matrix's of the coming solve
   bool refactor_next_ = false;  // the last reused solve needed many iterations
   int fresh_iterations_ = 0;    // iterative: the iterations of the last solve after a set-up
+  const BlockCoupling* coupling_ = nullptr;  // non-empty, or null
   VecX analysed_values_, factored_values_;
   GmresWork work_;
 };

@@ -616,14 +616,16 @@ class AleFlow {
     bodies_.initial_guess(cons, s.bodies, u);
     const auto residual = [&](const VecX& uu, SparseMatrix& J, VecX& r) {
       disc_.assemble(cons.expand(uu), &J, &r);
+      // in parts (MPI) the contact coupling between two bodies stays lagged
       bodies_.add_rows(s.bodies, c, cons, uu, r, J, gravity_, *contact_, t1,
-                       disc_.in_parts() ? &body_jacobian_here_ : nullptr);
+                       disc_.in_parts() ? &body_jacobian_here_ : nullptr, disc_.in_parts() ? nullptr : &coupling_);
     };
     NewtonOptions no{.linear = opt_.linearisation != Linearisation::newton,
                      .max_iterations = opt_.max_newton,
                      .tolerance = opt_.newton_tolerance};
     if (disc_.in_parts()) no.sum_parts = [this](VecX& v) { disc_.sum_parts(v); };
-    const NewtonReport nr = newton_solve(residual, disc_.linear_solve(), disc_.jacobian(), u, no);
+    coupling_.clear();
+    const NewtonReport nr = newton_solve(residual, disc_.linear_solve(), disc_.jacobian(), u, no, &coupling_);
     rep.newton_iterations = nr.iterations, rep.residuals = nr.residuals;
     rep.t_assembly = nr.t_assembly, rep.t_factorize = nr.t_factorize, rep.t_solve = nr.t_solve;
     rep.linear = nr.linear;
@@ -680,6 +682,7 @@ class AleFlow {
   std::unique_ptr<QuadraticGeometry<D>> geometry_;  // curved boundaries (null: straight cells)
   NodeVelocities<D> body_nodes_;  // the step's surface node velocities (scratch)
   std::vector<char> body_jacobian_here_;  // in parts: the bodies whose own Jacobian terms this process adds
+  BlockCoupling coupling_;  // the contact Jacobian between two bodies, beside the pattern (Newton's)
 };
 
 /// The mesh stored in a checkpoint written by AleFlow::save_checkpoint (to build the flow that

@@ -32,12 +32,14 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "alefsi/core/eigen_sparse.hpp"
 #include "alefsi/core/error.hpp"
 #include "alefsi/fem/constraints.hpp"
 #include "alefsi/la/assembler.hpp"
+#include "alefsi/la/coupling.hpp"
 #include "alefsi/mesh/mesh.hpp"
 #include "alefsi/physics/collision.hpp"
 #include "alefsi/physics/rigid_body.hpp"
@@ -398,9 +400,12 @@ class BodySystem {
   /// driven ones); each body's total is recorded in its state. With `jacobian_here` (J
   /// assembled in parts, one per MPI process: la/partition.hpp), body k's terms enter J only
   /// where jacobian_here[k] is set (one process; r is whole and takes them everywhere).
+  /// `coupling` (optional): the derivatives of a body's rows in the velocity of the free body it
+  /// touches, which J's pattern lacks (la/coupling.hpp), are put there; without it they are
+  /// left out (lagged: Newton then converges linearly while two bodies touch).
   void add_rows(std::vector<State>& states, const StepCoefficients& c, const DofConstraints& cons, const VecX& u, VecX& r,
                 SparseMatrix& J, const Vec<D>& gravity, const ContactModel<D>& contact, Real t1,
-                const std::vector<char>* jacobian_here = nullptr) const {
+                const std::vector<char>* jacobian_here = nullptr, BlockCoupling* coupling = nullptr) const {
     auto here = [&](std::size_t k) { return !jacobian_here || (*jacobian_here)[k]; };
     const Real a0 = c.flow_bdf[0];
     for (std::size_t k = 0; k < entries_.size(); ++k) {
@@ -422,8 +427,10 @@ class BodySystem {
       v[k] = M::is_free(entries_[k].data)
                  ? Vec<D>(u.template segment<D>(cons.extra_unknown(entries_[k].extra)))
                  : Vec<D>(M::prescribed_velocity(entries_[k].data, t1).template head<D>());
+    // d r_b / d V_other = H(arm)^T dF per (b, other) pair of free bodies, summed over contacts
+    std::vector<std::pair<std::array<int, 2>, Eigen::Matrix<Real, n_dof, D>>> pairs;
     // a force F at `arm` from the centre is the load H(arm)^T F (force and moment arm x F)
-    contact.forces(v, [&](int b, const Vec<D>& F, const Mat<D>& dF, const Vec<D>& arm) {
+    contact.forces(v, [&](int b, const Vec<D>& F, const Mat<D>& dF, const Vec<D>& arm, int other) {
       const bool moment = arm.squaredNorm() > 0;  // else G = (F, 0) exactly
       const auto H = M::rows(arm);
       Velocity G = Velocity::Zero();
@@ -433,13 +440,41 @@ class BodySystem {
       const Index row = cons.extra_unknown(entries_[b].extra);
       r.template segment<n_dof>(row) -= G;
       if (!here(std::size_t(b))) return;
+      Eigen::Matrix<Real, n_dof, D> dG = Eigen::Matrix<Real, n_dof, D>::Zero();  // d G / d V_b
       for (int i = 0; i < (moment ? n_dof : D); ++i)
         for (int j = 0; j < D; ++j) {
-          Real dG = 0;  // d G_i / d V_j = sum_d H[d]_i dF(d, j)
-          for (int d = 0; d < D; ++d) dG += H[d][i] * dF(d, j);
-          J.coeffRef(row + i, row + j) -= dG;
+          for (int d = 0; d < D; ++d) dG(i, j) += H[d][i] * dF(d, j);
+          J.coeffRef(row + i, row + j) -= dG(i, j);
         }
+      // G depends on V_b - V_other: d r_b / d V_other = +dG
+      if (!coupling || other < 0 || !M::is_free(entries_[std::size_t(other)].data)) return;
+      const std::array<int, 2> key{b, other};
+      auto it = std::find_if(pairs.begin(), pairs.end(), [&](const auto& p) { return p.first == key; });
+      if (it == pairs.end()) pairs.emplace_back(key, dG);
+      else it->second += dG;
     });
+    if (coupling) couple(pairs, cons, *coupling);
+  }
+
+  // The coupling's block: the unknowns of the bodies in `pairs` (ascending), and per (b, other)
+  // the n_dof x D derivative of b's rows in other's translational velocity.
+  template <class Pairs>
+  void couple(const Pairs& pairs, const DofConstraints& cons, BlockCoupling& C) const {
+    C.clear();
+    if (pairs.empty()) return;
+    std::vector<std::pair<Index, int>> first;  // (a body's first unknown, the body), ascending
+    for (const auto& [key, dG] : pairs)
+      for (int b : key) first.emplace_back(cons.extra_unknown(entries_[std::size_t(b)].extra), b);
+    std::sort(first.begin(), first.end());
+    first.erase(std::unique(first.begin(), first.end()), first.end());
+    for (const auto& [f, b] : first)  // a body's n_dof unknowns are consecutive
+      for (int i = 0; i < n_dof; ++i) C.index.push_back(f + i);
+    C.block = MatX::Zero(C.size(), C.size());
+    auto at = [&](int b) {
+      const auto it = std::find_if(first.begin(), first.end(), [b](const auto& p) { return p.second == b; });
+      return n_dof * Index(it - first.begin());
+    };
+    for (const auto& [key, dG] : pairs) C.block.block(at(key[0]), at(key[1]), n_dof, D) += dG;
   }
 
   /// The first of the n_dof unknowns of body k (-1: a driven body has none).

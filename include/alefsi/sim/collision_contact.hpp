@@ -78,8 +78,8 @@ class CollisionContact final : public ContactModel<D> {
     for (const auto& c : contacts_) {
       const Vec<D> F = CollisionModel<D>::force(c, cb);
       const Mat<D> dF = CollisionModel<D>::dforce_dvk(c, cb);
-      visit(c.k, F, dF, c.arm_k);  // dF_j / dV_j = -dF_k / dV_j = dF_k / dV_k
-      if (c.j >= 0) visit(c.j, Vec<D>(-F), dF, c.arm_j);
+      visit(c.k, F, dF, c.arm_k, c.j);  // dF_j / dV_j = -dF_k / dV_j = dF_k / dV_k
+      if (c.j >= 0) visit(c.j, Vec<D>(-F), dF, c.arm_j, c.k);
     }
   }
 

@@ -12,12 +12,14 @@
 ///     and `times_to_contact(bodies)`: gap over closing speed (the adaptive driver's event);
 ///   - `find(bodies, mu)` then `forces(velocities, visit)`: the contacts of the step being
 ///     solved, from the bodies placed at t^{n+1}, and their forces at the velocities of the
-///     current Newton iterate. For each contact, `visit(body, F, dF, arm)` is called on each
-///     free or driven body it acts on with the force F on that body, dF = dF/dV of that body's
-///     own translational velocity (the coupling between two bodies' rows is lagged: it is not
-///     in the pattern) and `arm`, from the body's centre to the point where F acts (0: through
-///     the centre). The flow subtracts the force and its moment arm x F from the body's rows,
-///     and their derivatives from its Jacobian block.
+///     current Newton iterate. For each contact, `visit(body, F, dF, arm, other)` is called on
+///     each free or driven body it acts on with the force F on that body, dF = dF/dV of that
+///     body's own translational velocity, `arm`, from the body's centre to the point where F
+///     acts (0: through the centre), and `other`, the body on the contact's other side (-1: a
+///     wall). F depends on the velocities through V_body - V_other only, so dF/dV_other = -dF.
+///     The flow subtracts the force and its moment arm x F from the body's rows, their
+///     derivatives from its Jacobian block, and the coupling to the other body's velocity
+///     through a dense block beside the assembled pattern (la/coupling.hpp, sim/body_system.hpp).
 ///
 /// Models: `NoContact<D>` (no forces, no gaps, no overlap checks) and `CollisionContact<D>`
 /// (sim/collision_contact.hpp, 2D and 3D: the paper's eq. (24) made repulsive, the spring
@@ -28,8 +30,10 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <utility>
 #include <vector>
 
+#include "alefsi/core/error.hpp"
 #include "alefsi/core/types.hpp"
 #include "alefsi/mesh/mesh.hpp"
 #include "alefsi/physics/convex.hpp"
@@ -60,7 +64,8 @@ struct ContactOverlap {
 template <int D>
 class ContactModel {
  public:
-  using Visit = std::function<void(int body, const Vec<D>& force, const Mat<D>& dforce, const Vec<D>& arm)>;
+  using Visit =
+      std::function<void(int body, const Vec<D>& force, const Mat<D>& dforce, const Vec<D>& arm, int other)>;
   virtual ~ContactModel() = default;
   /// The fixed walls: the boundary facets of `mesh` whose tag is none of `body_tags`.
   virtual void set_walls(const Mesh<D>& mesh, const std::vector<int>& body_tags) = 0;
@@ -91,6 +96,31 @@ class NoContact final : public ContactModel<D> {
   }
   int find(const std::vector<ContactBody<D>>&, Real) override { return 0; }
   void forces(const std::vector<Vec<D>>&, const typename ContactModel<D>::Visit&) const override {}
+};
+
+/// Another model with the coupling between two bodies hidden: each force is visited as if its
+/// other side were a wall, so the flow lags dF/dV_other (Newton then converges linearly while
+/// two bodies touch, to the same solution). For measuring what the coupling buys (the
+/// collision tests, bench/contact_newton.cpp); the forces are the model's.
+template <int D>
+class LaggedPairCoupling final : public ContactModel<D> {
+ public:
+  explicit LaggedPairCoupling(std::unique_ptr<ContactModel<D>> model) : model_(std::move(model)) {
+    ALEFSI_CHECK_ARG(model_ != nullptr, "model", "is empty");
+  }
+  void set_walls(const Mesh<D>& mesh, const std::vector<int>& body_tags) override { model_->set_walls(mesh, body_tags); }
+  std::vector<ContactOverlap> overlaps(const std::vector<ContactBody<D>>& b) const override { return model_->overlaps(b); }
+  std::vector<Real> gaps(const std::vector<ContactBody<D>>& b) const override { return model_->gaps(b); }
+  std::vector<Real> times_to_contact(const std::vector<ContactBody<D>>& b) const override {
+    return model_->times_to_contact(b);
+  }
+  int find(const std::vector<ContactBody<D>>& b, Real mu) override { return model_->find(b, mu); }
+  void forces(const std::vector<Vec<D>>& v, const typename ContactModel<D>::Visit& visit) const override {
+    model_->forces(v, [&](int b, const Vec<D>& F, const Mat<D>& dF, const Vec<D>& arm, int) { visit(b, F, dF, arm, -1); });
+  }
+
+ private:
+  std::unique_ptr<ContactModel<D>> model_;
 };
 
 /// The contact models a flow of dimension D starts with: `geometry()` (no forces; gaps and

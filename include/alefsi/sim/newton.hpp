@@ -23,6 +23,8 @@
 /// `linear` (the semi-implicit form): exactly one update, no test.
 /// Each update's linear solve goes through `LinearSolve::solve(J, r)`: a factorisation of J, or,
 /// with factorisation reuse on (FactorisationReuse), GMRES preconditioned by an earlier one.
+/// `coupling` (optional, la/coupling.hpp): Jacobian entries beside J's pattern, filled by
+/// `residual` with J (the contact between two bodies); the update then solves (J + C) du = r.
 /// Failure: a non-finite residual, or `max_iterations` updates without meeting the test, throws
 /// SolverError (with the iteration and the residuals); `u` is then the last iterate.
 ///
@@ -89,8 +91,13 @@ inline Real scaled_residual(const SparseMatrix& J, const VecX& r, const VecX& u,
 }  // namespace detail
 
 template <class Residual, LinearSolver S>
-NewtonReport newton_solve(Residual&& residual, LinearSolve<S>& lin, SparseMatrix& J, VecX& u, const NewtonOptions& opt) {
+NewtonReport newton_solve(Residual&& residual, LinearSolve<S>& lin, SparseMatrix& J, VecX& u, const NewtonOptions& opt,
+                          const BlockCoupling* coupling = nullptr) {
   NewtonReport rep;
+  struct Unset {  // the solver forgets the coupling when Newton returns or throws
+    LinearSolve<S>& lin;
+    ~Unset() { lin.set_coupling(nullptr); }
+  } unset{lin};
   auto clock = std::chrono::steady_clock::now();
   auto lap = [&clock](Real& acc) {
     const auto now = std::chrono::steady_clock::now();
@@ -116,6 +123,7 @@ NewtonReport newton_solve(Residual&& residual, LinearSolve<S>& lin, SparseMatrix
     if (!opt.linear && it == opt.max_iterations)
       throw SolverError("Newton did not converge in " + std::to_string(it) + " iterations (residual " + detail::sci(rn) +
                         ", first " + detail::sci(r0) + ")");
+    lin.set_coupling(coupling);
     if (!lin.reusable()) {
       lin.factorize(J);
       ++rep.linear.factorisations;

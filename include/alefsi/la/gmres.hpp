@@ -62,8 +62,9 @@ GmresResult gmres(const Matrix& A, const VecX& b, Precondition&& precondition, c
   const Real target = opt.tolerance * bnorm;
   MatX& V = work.V;
   MatX& Z = work.Z;  // unit corrections of the latest cycles, newest first
-  if (V.cols() != m + k_aug + 1 || V.rows() != n) V.resize(n, m + k_aug + 1);
-  if (Z.cols() != k_aug || Z.rows() != n) Z.resize(n, k_aug);
+  // grown, never shrunk: callers alternate between restart lengths (LinearSolve's coupled solves)
+  if (V.cols() < m + k_aug + 1 || V.rows() != n) V.resize(n, m + k_aug + 1);
+  if (Z.cols() < k_aug || Z.rows() != n) Z.resize(n, k_aug);
   int n_z = 0;  // corrections stored so far (< k_aug in the first cycles)
   MatX H = MatX::Zero(m + k_aug + 1, m + k_aug);
   VecX g(m + k_aug + 1), cs(m + k_aug), sn(m + k_aug), w(n);

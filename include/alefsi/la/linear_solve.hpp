@@ -46,7 +46,8 @@ struct FactorisationReuse {
 struct LinearSolveCounts {
   int factorisations = 0;     ///< numeric factorisations (an iterative solver's set-ups)
   int reused = 0;             ///< solves by GMRES on an earlier factorisation
-  int krylov_iterations = 0;  ///< their GMRES iterations
+  int krylov_iterations = 0;  ///< their GMRES iterations, and those of solves with a coupling
+                              ///< (la/coupling.hpp) on fresh factors
   int iterative_solves = 0;      ///< solves by an iterative solver (one with `iterations()`)
   int iterative_iterations = 0;  ///< their iterations
   LinearSolveCounts& operator+=(const LinearSolveCounts& o) {
@@ -88,9 +89,11 @@ class LinearSolve {
     factored_ = false;
     analysed_values_.resize(0), factored_values_.resize(0);
   }
-  /// Entries beside J's pattern that the coming factorisations and solves include (null or
-  /// empty: none); the object must stay alive until it is unset. An iterative solver that takes
-  /// one (`set_coupling`) is handed it.
+  /// Entries C beside J's pattern that the coming solves include (null or empty: none): they
+  /// solve (J + C) x = r. A direct solver's factors stay J's (GMRES on J + C, at most
+  /// FactorisationReuse::max_iterations + C's size iterations on kept factors, C's size + 4 on
+  /// fresh ones, to FactorisationReuse::tolerance); an iterative solver that takes one
+  /// (`set_coupling`) is handed it. The object must stay alive until it is unset.
   void set_coupling(const BlockCoupling* c) {
     coupling_ = c && !c->empty() ? c : nullptr;
     if constexpr (requires { solver_.set_coupling(c); }) solver_.set_coupling(coupling_);
@@ -111,8 +114,9 @@ class LinearSolve {
   /// The next solve of a new matrix can use the factors at hand (no factorisation first).
   bool reusable() const { return reuse_.enabled && factored_ && !refactor_next_; }
   VecX solve(const VecX& r) { return solver_.solve(r); }
-  /// Solves J x = r: directly after factorize(J); otherwise by GMRES preconditioned by the
-  /// factors at hand, and, when that misses its tolerance in max_iterations, by factorising J.
+  /// Solves J x = r (with a coupling: (J + C) x = r, `set_coupling`): directly after
+  /// factorize(J); otherwise by GMRES preconditioned by the factors at hand, and, when that
+  /// misses its tolerance in max_iterations, by factorising J.
   VecX solve(const SparseMatrix& J, const VecX& r, LinearSolveCounts& counts) {
     if constexpr (DirectSolver<S>)
       if (coupling_) return solve_coupled(J, r, counts);

@@ -568,6 +568,63 @@ TEST_CASE("SaddlePointGmres keeps its set-up for later matrices of the same patt
   CHECK_THROWS_WITH(lin.solver().solve(small, VecX::Ones(nu)), Catch::Contains("pattern"));
 }
 
+TEST_CASE("SaddlePointGmres with a coupling among the extra unknowns: the solve is with A + C, the body "
+          "elimination includes C",
+          "[la][solvers][krylov][quick]") {
+  // the 3D cavity with two extra unknowns appended (as two bodies' would be), each linked to a
+  // velocity unknown; C couples the two extras, as a contact couples two bodies' rows
+  const auto s = cavity3d<TaylorHood>(3);
+  const Index n0 = s.A.rows(), n = n0 + 2;
+  std::vector<Eigen::Triplet<Real>> t;
+  for (Index c = 0; c < s.A.outerSize(); ++c)
+    for (SparseMatrix::InnerIterator it(s.A, c); it; ++it) t.emplace_back(it.row(), it.col(), it.value());
+  using Link = std::tuple<Index, Index, Real>;  // extra unknown, its velocity unknown, its diagonal
+  for (const auto& [e, u, diag] : {Link{n0, 0, 2.0}, Link{n0 + 1, 7, 3.0}}) {
+    t.emplace_back(e, e, diag);
+    t.emplace_back(e, u, 0.1), t.emplace_back(u, e, 0.1);
+  }
+  SparseMatrix A(n, n);
+  A.setFromTriplets(t.begin(), t.end());
+  VecX b(n);
+  b << s.b, 1.0, -2.0;
+  SaddlePointBlocks blocks = s.blocks;
+  blocks.n_extra = 2;
+  BlockCoupling C;
+  C.index = {n0, n0 + 1};
+  C.block = MatX{{0.0, 0.7}, {-0.4, 0.0}};
+  SparseMatrix AC = A;
+  AC.coeffRef(n0, n0 + 1) += 0.7, AC.coeffRef(n0 + 1, n0) -= 0.4;
+  const VecX reference = solve_with<SparseLu<>>(AC, b);
+  KrylovOptions opt;
+  opt.tolerance = 1e-10;
+  auto run = [&](const BlockCoupling* c, const SparseMatrix& M, int& its) {
+    LinearSolve<SaddlePointGmres<3>> lin(opt);
+    lin.solver().set_blocks(blocks);
+    lin.set_coupling(c);
+    lin.factorize(A);
+    LinearSolveCounts counts;
+    const VecX x = lin.solve(A, b, counts);
+    its = counts.iterative_iterations;
+    CHECK(relative_residual(M, x, b) <= opt.tolerance);
+    return x;
+  };
+  int coupled = 0, plain = 0;
+  const VecX x = run(&C, AC, coupled);
+  CHECK((x - reference).norm() <= 1e-7 * reference.norm());
+  CHECK(std::abs(x[n0 + 1] - reference[n0 + 1]) <= 1e-7 * std::abs(reference[n0 + 1]));
+  run(nullptr, A, plain);
+  INFO("GMRES iterations with C " << coupled << ", without " << plain);
+  CHECK(coupled <= plain + 2);  // C is eliminated exactly with the extras: no more iterations
+  // a coupling on a velocity unknown is refused by name
+  BlockCoupling bad;
+  bad.index = {0, n0};
+  bad.block = MatX::Identity(2, 2);
+  LinearSolve<SaddlePointGmres<3>> lin(opt);
+  lin.solver().set_blocks(blocks);
+  lin.set_coupling(&bad);
+  CHECK_THROWS_WITH(lin.factorize(A), Catch::Contains("coupling"));
+}
+
 TEST_CASE("SaddlePointGmres: iteration counts under refinement (Schur approximations are mesh-independent)",
           "[la][solvers][krylov][quick]") {
   // Taylor–Hood with exact velocity solves (the AMG's coarsest level holds the whole block):

@@ -108,9 +108,9 @@ void check_body_jacobian(const Space& space, Bodies& bodies, States& states, con
   };
   SparseMatrix J;
   const VecX r = rows(u, J);
-  // the Jacobian among the bodies' unknowns (all free here, after the flow's): J's and C's
+  // the Jacobian among the free bodies' unknowns (after the flow's): J's and C's
   constexpr int nd = Bodies::n_dof;
-  const Index e0 = cons.n_free(), ne = Index(bodies.size()) * nd;
+  const Index e0 = cons.n_free(), ne = n - e0;
   MatX Jb = MatX(J.block(e0, e0, ne, ne));
   for (Index a = 0; a < C.size(); ++a)
     for (Index b = 0; b < C.size(); ++b) Jb(C.index[std::size_t(a)] - e0, C.index[std::size_t(b)] - e0) += C.block(a, b);
@@ -160,6 +160,36 @@ TEST_CASE("body rows: the body blocks of add_rows match finite differences (2D w
     // momentum balance: the contact forces on the two bodies cancel
     CHECK((states[0].contact + states[1].contact).norm() <= 1e-14 * states[0].contact.norm());
     CHECK(states[0].contact.norm() > 0);
+  }
+  SECTION("2D: three disks in contact pairwise, the middle one of the list driven") {
+    // free A, driven D, free B: the pairs A-B (free-free: coupled), A-D and D-B (a driven side:
+    // no unknowns to couple to), the free bodies' unknowns in slots 0 and 1
+    const Real R = 0.25;
+    const std::vector<Circle> disks = {{Vec<2>(0.7, 1), R, 5}, {Vec<2>(0.985, 1.5), R, 6}, {Vec<2>(1.27, 1.0), R, 7}};
+    const Mesh<2> mesh = channel_with_disks(2, 2.2, disks, 0.05, 0.3);
+    MixedSpace<2, TaylorHood> space(mesh);
+    BodySystem<2, RigidBodyTraits<2>> bodies;
+    std::vector<BodyState<2, RigidBodyTraits<2>>> states;
+    for (const auto& d : disks) {
+      RigidBody2D b = disk_body(d.tag, d.centre, R, 1.5);
+      if (d.tag == 6) b.prescribed = [](Real) { return Vec<3>(0.2, -0.3, 0.5); };
+      bodies.add(b, mesh, 0.0, states);
+    }
+    states[0].velocity.fill(Vec<3>(0.4, 0.1, 0.3));
+    states[2].velocity.fill(Vec<3>(-0.5, 0.2, -0.1));
+    bodies.attach(mesh);
+    const StepCoefficients c = step_coefficients<BDF2_BDF2E>(0.01, TimeHistory{});
+    NodeVelocities<2> nodes;
+    bodies.mesh_velocity_data(states, mesh.coordinates(), c.extrapolation, 0.01, nodes);
+    std::vector<Vec<2>> x = mesh.coordinates();
+    bodies.advance(states, c, x);
+    CollisionContact2D contact(CollisionOptions{.range = 0.5, .spring_range = 0.1, .spring_force = 3});
+    contact.set_walls(mesh, bodies.tags());
+    REQUIRE(contact.find(bodies.contact_bodies(states, -1), 0.01) == 3);
+    REQUIRE(!bodies.is_free(1));
+    check_body_jacobian<2>(space, bodies, states, contact, c, Vec<2>(0, -9.81));
+    // action = reaction over the three
+    CHECK((states[0].contact + states[1].contact + states[2].contact).head<2>().norm() <= 1e-14 * states[0].contact.norm());
   }
   SECTION("2D: two squares, a corner near an edge away from the centre (a contact moment)") {
     // square A = [0.5, 0.9] x [0.8, 1.2]; square B of the same size about (1.2, 1.1) turned by

@@ -614,18 +614,18 @@ class AleFlow {
     disc_.prepare_solver(opt_.rho * c.flow_bdf[0] / (c.theta * c.dt));
     VecX u = cons.restrict_free(s.U[0]);
     bodies_.initial_guess(cons, s.bodies, u);
+    // in parts (MPI) the contact coupling between two bodies stays lagged; add_rows refills it
+    BlockCoupling* coupling = disc_.in_parts() ? nullptr : &coupling_;
     const auto residual = [&](const VecX& uu, SparseMatrix& J, VecX& r) {
       disc_.assemble(cons.expand(uu), &J, &r);
-      // in parts (MPI) the contact coupling between two bodies stays lagged
       bodies_.add_rows(s.bodies, c, cons, uu, r, J, gravity_, *contact_, t1,
-                       disc_.in_parts() ? &body_jacobian_here_ : nullptr, disc_.in_parts() ? nullptr : &coupling_);
+                       disc_.in_parts() ? &body_jacobian_here_ : nullptr, coupling);
     };
     NewtonOptions no{.linear = opt_.linearisation != Linearisation::newton,
                      .max_iterations = opt_.max_newton,
                      .tolerance = opt_.newton_tolerance};
     if (disc_.in_parts()) no.sum_parts = [this](VecX& v) { disc_.sum_parts(v); };
-    coupling_.clear();
-    const NewtonReport nr = newton_solve(residual, disc_.linear_solve(), disc_.jacobian(), u, no, &coupling_);
+    const NewtonReport nr = newton_solve(residual, disc_.linear_solve(), disc_.jacobian(), u, no, coupling);
     rep.newton_iterations = nr.iterations, rep.residuals = nr.residuals;
     rep.t_assembly = nr.t_assembly, rep.t_factorize = nr.t_factorize, rep.t_solve = nr.t_solve;
     rep.linear = nr.linear;

@@ -135,6 +135,21 @@ void check_body_jacobian(const Space& space, Bodies& bodies, States& states, con
 }
 }  // namespace
 
+namespace {
+// The 2D bodies attached to `mesh` and moved through one BDF2 step of 0.01 from the velocities
+// their states hold: where the step's contacts are found. Returns the step's coefficients.
+StepCoefficients place_after_step(BodySystem<2, RigidBodyTraits<2>>& bodies,
+                                  std::vector<BodyState<2, RigidBodyTraits<2>>>& states, const Mesh<2>& mesh) {
+  bodies.attach(mesh);
+  const StepCoefficients c = step_coefficients<BDF2_BDF2E>(0.01, TimeHistory{});
+  NodeVelocities<2> nodes;
+  bodies.mesh_velocity_data(states, mesh.coordinates(), c.extrapolation, 0.01, nodes);
+  std::vector<Vec<2>> x = mesh.coordinates();
+  bodies.advance(states, c, x);
+  return c;
+}
+}  // namespace
+
 TEST_CASE("body rows: the body blocks of add_rows match finite differences (2D with contact forces, 3D gyroscopic)",
           "[sim][bodies][quick]") {
   SECTION("2D: two disks within the contact range") {
@@ -147,12 +162,7 @@ TEST_CASE("body rows: the body blocks of add_rows match finite differences (2D w
     for (const auto& d : disks) bodies.add(disk_body(d.tag, d.centre, R, 1.5), mesh, 0.0, states);
     states[0].velocity.fill(Vec<3>(0.4, 0.1, 0.3));
     states[1].velocity.fill(Vec<3>(-0.5, 0.2, -0.1));
-    bodies.attach(mesh);
-    const StepCoefficients c = step_coefficients<BDF2_BDF2E>(0.01, TimeHistory{});
-    NodeVelocities<2> nodes;
-    bodies.mesh_velocity_data(states, mesh.coordinates(), c.extrapolation, 0.01, nodes);
-    std::vector<Vec<2>> x = mesh.coordinates();
-    bodies.advance(states, c, x);
+    const StepCoefficients c = place_after_step(bodies, states, mesh);
     CollisionContact2D contact(CollisionOptions{.range = 0.5, .spring_range = 0.1, .spring_force = 3});
     contact.set_walls(mesh, bodies.tags());
     REQUIRE(contact.find(bodies.contact_bodies(states, -1), 0.01) == 1);
@@ -177,12 +187,7 @@ TEST_CASE("body rows: the body blocks of add_rows match finite differences (2D w
     }
     states[0].velocity.fill(Vec<3>(0.4, 0.1, 0.3));
     states[2].velocity.fill(Vec<3>(-0.5, 0.2, -0.1));
-    bodies.attach(mesh);
-    const StepCoefficients c = step_coefficients<BDF2_BDF2E>(0.01, TimeHistory{});
-    NodeVelocities<2> nodes;
-    bodies.mesh_velocity_data(states, mesh.coordinates(), c.extrapolation, 0.01, nodes);
-    std::vector<Vec<2>> x = mesh.coordinates();
-    bodies.advance(states, c, x);
+    const StepCoefficients c = place_after_step(bodies, states, mesh);
     CollisionContact2D contact(CollisionOptions{.range = 0.5, .spring_range = 0.1, .spring_force = 3});
     contact.set_walls(mesh, bodies.tags());
     REQUIRE(contact.find(bodies.contact_bodies(states, -1), 0.01) == 3);
@@ -212,12 +217,7 @@ TEST_CASE("body rows: the body blocks of add_rows match finite differences (2D w
     for (const auto& p : squares) bodies.add(free_body(p.tag, mass_properties(p, 1.5)), mesh, 0.0, states);
     states[0].velocity.fill(Vec<3>(0.4, 0.1, 0.3));
     states[1].velocity.fill(Vec<3>(-0.5, 0.2, -0.1));
-    bodies.attach(mesh);
-    const StepCoefficients c = step_coefficients<BDF2_BDF2E>(0.01, TimeHistory{});
-    NodeVelocities<2> nodes;
-    bodies.mesh_velocity_data(states, mesh.coordinates(), c.extrapolation, 0.01, nodes);
-    std::vector<Vec<2>> x = mesh.coordinates();
-    bodies.advance(states, c, x);
+    const StepCoefficients c = place_after_step(bodies, states, mesh);
     CollisionContact2D contact(CollisionOptions{.range = 0.5, .spring_range = 0.05, .spring_force = 3});
     contact.set_walls(mesh, bodies.tags());
     const auto placed = bodies.contact_bodies(states, -1);
@@ -253,11 +253,7 @@ TEST_CASE("body rows: the body blocks of add_rows match finite differences (2D w
     }
     shaped_states[0].velocity.fill(Vec<3>(0.4, 0.1, 0.3));
     shaped_states[1].velocity.fill(Vec<3>(-0.5, 0.2, -0.1));
-    shaped.attach(mesh);
-    NodeVelocities<2> shaped_nodes;
-    shaped.mesh_velocity_data(shaped_states, mesh.coordinates(), c.extrapolation, 0.01, shaped_nodes);
-    std::vector<Vec<2>> y = mesh.coordinates();
-    shaped.advance(shaped_states, c, y);
+    place_after_step(shaped, shaped_states, mesh);
     const auto with_shapes = shaped.contact_bodies(shaped_states, -1);
     CHECK(with_shapes[1].surface.empty());  // the shape replaces the facets
     REQUIRE(contact.find(with_shapes, 0.01) == 1);

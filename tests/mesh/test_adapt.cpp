@@ -476,6 +476,79 @@ TEST_CASE("transfer: outside points (curved boundary) clamped or extrapolated", 
   CHECK(err2 <= 4 * outside);
 }
 
+namespace {
+// The field f as the isoparametric P`degree` space on `m` with edge points `ep` holds it: its
+// values at the nodes, then (P2) at the edge points.
+std::vector<double> interpolate_at(const Mesh<2>& m, int degree, const std::vector<Vec<2>>& ep,
+                                   const std::function<double(const Vec<2>&)>& f) {
+  std::vector<double> v;
+  for (Index i = 0; i < m.n_nodes(); ++i) v.push_back(f(m.node(i)));
+  if (degree == 2)
+    for (const auto& p : ep) v.push_back(f(p));
+  return v;
+}
+}  // namespace
+
+TEST_CASE("transfer: from curved cells (isoparametric P2), exact for the space and O(h^3)", "[mesh][adapt]") {
+  // A source annulus whose boundary edges have their points on the arcs (curved_edge_midpoints):
+  // its cells are the P2 maps' images and its fields polynomials of the reference coordinates.
+  // Mapping the target points back through the straight cells instead is an O(h^2) error in the
+  // reference point beside the arcs, which the affine field shows at once.
+  const Domain2D dom{Circle{Vec<2>::Zero(), 1.0, tags::outer}, {Circle{Vec<2>::Zero(), 0.25, tags::inner}}};
+  const Mesh<2> to = annulus_unstructured(0.25, 1.0, 0.03);
+  const std::vector<Vec<2>> to_arcs = curved_edge_midpoints(to, dom);
+  auto lin = [](const Vec<2>& x) { return 2.0 + 3.0 * x[0] - 1.0 * x[1]; };
+  {
+    const Mesh<2> from = annulus_unstructured(0.25, 1.0, 0.12);
+    const std::vector<Vec<2>> arcs = curved_edge_midpoints(from, dom);
+    // isoparametric P2 holds the affine fields (P1 on curved cells does not: it is linear in
+    // the reference coordinates, which are not affine in x there)
+    const auto src = interpolate_at(from, 2, arcs, lin);
+    const FieldTransfer2D curved(from, to, 2, to_arcs, OutsidePolicy::extrapolate, arcs);
+    const FieldTransfer2D straight(from, to, 2, to_arcs, OutsidePolicy::extrapolate);
+    const auto vc = curved.apply(src), vs = straight.apply(src);
+    const auto exact = interpolate_at(to, 2, to_arcs, lin);
+    double ec = 0, es = 0;
+    for (std::size_t i = 0; i < exact.size(); ++i)
+      ec = std::max(ec, std::abs(vc[i] - exact[i])), es = std::max(es, std::abs(vs[i] - exact[i]));
+    std::printf("P2 transfer from curved cells, affine field: max error %.2e (straight location %.2e); %d points "
+                "outside, at most %.1e\n",
+                ec, es, curved.n_outside(), curved.max_outside_distance());
+    CHECK(ec <= 1e-12);
+    CHECK(es > 1e-4);  // the straight cells' coordinates: O(h^2) beside the arcs
+    // The target's arc points lie outside the source's boundary, the parabola through each
+    // boundary edge's ends and its arc's midpoint: in the chord coordinate s the arc is
+    // -s^2 / (2 r) - s^4 / (8 r^3) + ..., whose s^4 term the parabola misses by at most
+    // h^4 / (512 r^3) (at s^2 = h^2 / 8), h the chord: 2.6e-5 for h = 0.12, r = 0.25.
+    CHECK(curved.n_outside() > 0);
+    CHECK(curved.max_outside_distance() <= std::pow(0.12, 4) / (512 * std::pow(0.25, 3)));
+  }
+  // a smooth field, the interpolant of the isoparametric P2 space: O(h^3) with the curved
+  // location, O(h^2) with the straight one (the error is at the points beside the arcs)
+  auto f = [](const Vec<2>& x) { return std::sin(3 * x[0] + 1) * std::cos(2 * x[1]); };
+  const auto exact = interpolate_at(to, 2, to_arcs, f);
+  std::vector<double> ec, es;
+  for (double h : {0.16, 0.08, 0.04}) {
+    const Mesh<2> from = annulus_unstructured(0.25, 1.0, h);
+    const std::vector<Vec<2>> arcs = curved_edge_midpoints(from, dom);
+    const auto src = interpolate_at(from, 2, arcs, f);
+    const auto vc = FieldTransfer2D(from, to, 2, to_arcs, OutsidePolicy::clamp, arcs).apply(src);
+    const auto vs = FieldTransfer2D(from, to, 2, to_arcs).apply(src);
+    double mc = 0, ms = 0;
+    for (std::size_t i = 0; i < exact.size(); ++i)
+      mc = std::max(mc, std::abs(vc[i] - exact[i])), ms = std::max(ms, std::abs(vs[i] - exact[i]));
+    ec.push_back(mc), es.push_back(ms);
+  }
+  for (std::size_t k = 1; k < ec.size(); ++k)
+    std::printf("P2 transfer from the annulus at h = %.3g: curved %.3e (rate %.2f), straight location %.3e (rate %.2f)\n",
+                0.16 / double(1 << k), ec[k], std::log2(ec[k - 1] / ec[k]), es[k], std::log2(es[k - 1] / es[k]));
+  // the mesher's meshes are not nested, so the max norm's rate varies from one halving to the
+  // next (2.6 then 3.6 here): the rate over both halvings
+  const double rc = std::log2(ec[0] / ec[2]) / 2, rs = std::log2(es[0] / es[2]) / 2;
+  CHECK(rc >= 3 - 0.3);
+  CHECK(rs <= 2 + 0.3);
+}
+
 TEST_CASE("transfer: convergence at the interpolation order for a smooth field", "[mesh][adapt]") {
   auto f = [](const Vec<2>& x) { return std::sin(3 * x[0] + 1) * std::cos(2 * x[1]); };
   const Mesh<2> to = square_mesh(0.02);

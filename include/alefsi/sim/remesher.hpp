@@ -60,12 +60,16 @@ class MeshTransfer {
 };
 
 /// The MeshTransfer of both remeshers: interpolation (FieldTransfer<D>) by P1 and by the
-/// velocity degree, the plans built once per remesh.
+/// velocity degree, the plans built once per remesh. With curved cells (isoparametric P2), the
+/// edge points of both meshes: the old cells are mapped back through their quadratic maps and
+/// the new P2 DOFs sit at the new edge points (mesh/adapt/transfer.hpp).
 template <int D>
 class LagrangeTransfer final : public MeshTransfer<D> {
  public:
-  LagrangeTransfer(const Mesh<D>& from, const Mesh<D>& to, int velocity_degree) : p1_(from, to, 1) {
-    if (velocity_degree != 1) pk_.emplace(from, to, velocity_degree);
+  LagrangeTransfer(const Mesh<D>& from, const Mesh<D>& to, int velocity_degree,
+                   const std::vector<Vec<D>>& from_edge_points = {}, const std::vector<Vec<D>>& to_edge_points = {})
+      : p1_(from, to, 1, {}, OutsidePolicy::clamp, from_edge_points) {
+    if (velocity_degree != 1) pk_.emplace(from, to, velocity_degree, to_edge_points, OutsidePolicy::clamp, from_edge_points);
   }
   std::vector<Real> apply(const std::vector<Real>& values, int components, int degree) const override {
     if (degree == 1) return p1_.apply(values, components);

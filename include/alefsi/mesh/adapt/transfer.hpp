@@ -15,6 +15,17 @@
 /// affine fields and P2 transfer for quadratic fields, and the error for a smooth field
 /// is the interpolation error, O(h^2) for P1 and O(h^3) for P2 (max norm).
 ///
+/// Curved source cells: with `from_edge_points` (one point per edge of the source mesh, e.g.
+/// `QuadraticGeometry::edge_points()`) a source cell whose edge points are off their midpoints is
+/// the image of the P2 (isoparametric) map of its vertices and edge points, and a source field
+/// is a polynomial of the reference coordinates there. A target point in such a cell is then
+/// mapped back by Newton's method on that map (from the straight cell's coordinates; 2-4
+/// iterations), walking to the neighbour across a facet while the coordinates leave the cell;
+/// a field of the source's isoparametric space is then reproduced exactly (in P2 the affine
+/// functions of x are such fields; in P1 on a curved cell they are not).
+/// Without it the straight cell's coordinates are used, an O(h^2) error in the reference
+/// point beside a curved boundary and so an O(h^2) error in the value.
+///
 /// Points outside the source mesh (a new boundary node put on a circle arc / a sphere lies
 /// outside the inscribed polygon / polyhedron of the old mesh, at a distance O(h^2 / radius)): by default
 /// (`OutsidePolicy::clamp`) the value at the point of the nearest source cell closest to
@@ -35,6 +46,7 @@
 ///     auto p_new = alefsi::transfer<1>(old_mesh, p_old, 1, new_mesh);
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -64,6 +76,33 @@ std::array<Real, 10> lagrange_weights(int degree, const Vec<D + 1>& l) {
   return w;
 }
 
+/// The P2 map of a cell with nodes X (vertices, then edge points in SimplexTopology<D>'s edge
+/// order), at barycentric coordinates l: the point x(l), and J = dx/dxi, xi = (l_1, .., l_D).
+template <int D>
+Vec<D> quadratic_map(const std::array<Vec<D>, 10>& X, const Vec<D + 1>& l, Mat<D>* J) {
+  Vec<D> x = Vec<D>::Zero();
+  Mat<D> dx = Mat<D>::Zero();
+  // d/dxi_j = d/dl_{j+1} - d/dl_0
+  auto add = [&](const Vec<D>& Xk, Real value, const Vec<D + 1>& dl) {
+    x += value * Xk;
+    for (int j = 0; j < D; ++j) dx.col(j) += (dl[j + 1] - dl[0]) * Xk;
+  };
+  for (int i = 0; i <= D; ++i) {
+    Vec<D + 1> dl = Vec<D + 1>::Zero();
+    dl[i] = 4 * l[i] - 1;
+    add(X[std::size_t(i)], l[i] * (2 * l[i] - 1), dl);
+  }
+  for (std::size_t e = 0; e < SimplexTopology<D>::edges.size(); ++e) {
+    const auto [a, b] = SimplexTopology<D>::edges[e];
+    Vec<D + 1> dl = Vec<D + 1>::Zero();
+    dl[a] = 4 * l[b];
+    dl[b] = 4 * l[a];
+    add(X[D + 1 + e], 4 * l[a] * l[b], dl);
+  }
+  if (J) *J = dx;
+  return x;
+}
+
 /// Number of DOFs of the scalar P1 / P2 space on a mesh (numbering of DofMap).
 template <int D>
 Index lagrange_dofs(const Mesh<D>& m, int degree) { return m.n_nodes() + (degree == 2 ? m.n_edges() : 0); }
@@ -78,13 +117,19 @@ class FieldTransfer {
  public:
   /// `to_edge_points` (P2 only, optional): the DOF point of each edge of `to` (indexed as
   /// to.edges()), e.g. the arc midpoint for edges on a circle; default: straight midpoints.
+  /// `from_edge_points` (optional, any degree): the point of each edge of `from`, which makes
+  /// the cells with displaced points curved (file comment); default: straight cells.
   FieldTransfer(const Mesh<D>& from, const Mesh<D>& to, int degree, const std::vector<Vec<D>>& to_edge_points = {},
-                OutsidePolicy outside = OutsidePolicy::clamp)
+                OutsidePolicy outside = OutsidePolicy::clamp, const std::vector<Vec<D>>& from_edge_points = {})
       : degree_(degree) {
     ALEFSI_CHECK_ARG(degree == 1 || degree == 2, "degree", "must be 1 or 2, got ", degree);
     ALEFSI_CHECK_ARG(to_edge_points.empty() || (degree == 2 && to_edge_points.size() == std::size_t(to.n_edges())),
                      "to_edge_points", "must be empty or (P2) have one point per edge of 'to' (", to.n_edges(), "), got ",
                      to_edge_points.size());
+    ALEFSI_CHECK_ARG(from_edge_points.empty() || from_edge_points.size() == std::size_t(from.n_edges()),
+                     "from_edge_points", "must be empty or have one point per edge of 'from' (", from.n_edges(),
+                     "), got ", from_edge_points.size());
+    const std::vector<char> curved = curved_cells(from, from_edge_points);
     n_from_ = detail::lagrange_dofs(from, degree);
     n_to_ = detail::lagrange_dofs(to, degree);
     nl_ = degree == 1 ? D + 1 : D + 1 + ne;
@@ -99,7 +144,8 @@ class FieldTransfer {
     std::vector<Index> found(std::size_t(to.n_nodes()), -1);
     Index prev = -1;
     auto store = [&](Index dof, const Vec<D>& x, Index hint) {
-      const PointLocation<D> l = loc.find(x, hint);
+      PointLocation<D> l = loc.find(x, hint);
+      if (!curved.empty()) l = on_curved_cells(from, from_edge_points, curved, x, l);
       if (l.distance > 0) ++n_outside_, max_outside_ = std::max(max_outside_, l.distance);
       const auto w = detail::lagrange_weights<D>(degree, outside == OutsidePolicy::extrapolate ? l.raw : l.lambda);
       const auto& cv = from.cell(l.cell);
@@ -163,6 +209,95 @@ class FieldTransfer {
   }
 
  private:
+  // Per source cell, whether an edge point is off its midpoint (empty: none is).
+  static std::vector<char> curved_cells(const Mesh<D>& from, const std::vector<Vec<D>>& points) {
+    if (points.empty()) return {};
+    std::vector<char> curved(std::size_t(from.n_cells()), 0);
+    bool any = false;
+    for (Index c = 0; c < from.n_cells(); ++c)
+      for (Index e : from.cell_edges(c)) {
+        const auto& ev = from.edge(e);
+        const Vec<D> m = 0.5 * (from.node(ev[0]) + from.node(ev[1]));
+        if ((points[std::size_t(e)] - m).norm() > 1e-12 * from.edge_length(e)) any = curved[std::size_t(c)] = 1;
+      }
+    return any ? curved : std::vector<char>{};
+  }
+
+  // The location of x among curved cells (file comment): Newton on the P2 map of the cell the
+  // straight location found, then of its neighbours while the coordinates leave the cell. A
+  // straight cell's image is its own (curved cells meet straight ones on flat facets): kept.
+  static PointLocation<D> on_curved_cells(const Mesh<D>& from, const std::vector<Vec<D>>& points,
+                                          const std::vector<char>& curved, const Vec<D>& x,
+                                          const PointLocation<D>& found) {
+    if (found.distance == 0 && !curved[std::size_t(found.cell)]) return found;
+    PointLocation<D> best;
+    Real best_out = 1e300;
+    Index c = found.cell, previous = -1;
+    for (int walk = 0; walk < 8; ++walk) {
+      Vec<D + 1> raw = affine_coordinates(from, c, x);
+      if (curved[std::size_t(c)]) {
+        const auto X = cell_nodes(from, points, c);
+        Vec<D + 1> lam = raw.cwiseMax(Real(0));  // inside its straight cell the map is near affine
+        lam /= lam.sum();
+        const Real scale = from.jacobian(c).norm();
+        bool converged = false;
+        for (int it = 0; it < 20 && !converged; ++it) {
+          Mat<D> J;
+          const Vec<D> r = x - detail::quadratic_map<D>(X, lam, &J);
+          if (r.norm() <= 1e-14 * scale) {
+            converged = true;
+            break;
+          }
+          const Vec<D> dxi = J.inverse() * r;
+          if (!dxi.allFinite()) break;
+          lam.template tail<D>() += dxi;
+          lam[0] -= dxi.sum();
+          converged = dxi.norm() <= 1e-15;
+        }
+        if (converged) raw = lam;  // else: the straight coordinates, to choose the walk's way
+      }
+      const Real out = std::max(Real(0), -raw.minCoeff());
+      if (out < best_out) {
+        best_out = out;
+        best.cell = c;
+        best.raw = raw;
+        best.lambda = raw;
+      }
+      if (out <= 1e-12) return best;  // inside, to round-off
+      int k = 0;  // across the facet opposite the most negative coordinate
+      for (int i = 1; i <= D; ++i)
+        if (raw[i] < raw[k]) k = i;
+      const auto& fc = from.facet_cells(from.cell_facets(c)[k]);
+      const Index next = fc[0] == c ? fc[1] : fc[0];
+      if (next < 0 || next == previous) break;
+      previous = c;
+      c = next;
+    }
+    // outside every cell tried (beyond the curved boundary): the nearest one's clamped point
+    best.lambda = best.raw.cwiseMax(Real(0));
+    best.lambda /= best.lambda.sum();
+    const Vec<D> y = curved[std::size_t(best.cell)]
+                         ? detail::quadratic_map<D>(cell_nodes(from, points, best.cell), best.lambda, nullptr)
+                         : Vec<D>(from.node(from.cell(best.cell)[0]) +
+                                  from.jacobian(best.cell) * Vec<D>(best.lambda.template tail<D>()));
+    best.distance = std::max((x - y).norm(), std::numeric_limits<Real>::min());
+    return best;
+  }
+  static Vec<D + 1> affine_coordinates(const Mesh<D>& from, Index c, const Vec<D>& x) {
+    const Vec<D> xi = from.jacobian(c).inverse() * (x - from.node(from.cell(c)[0]));
+    Vec<D + 1> l;
+    l[0] = 1 - xi.sum();
+    l.template tail<D>() = xi;
+    return l;
+  }
+  static std::array<Vec<D>, 10> cell_nodes(const Mesh<D>& from, const std::vector<Vec<D>>& points, Index c) {
+    std::array<Vec<D>, 10> X;
+    const auto& cv = from.cell(c);
+    for (int i = 0; i <= D; ++i) X[std::size_t(i)] = from.node(cv[i]);
+    for (int e = 0; e < ne; ++e) X[std::size_t(D + 1 + e)] = points[std::size_t(from.cell_edges(c)[e])];
+    return X;
+  }
+
   int degree_;
   int nl_ = D + 1;
   Index n_from_ = 0, n_to_ = 0, n_outside_ = 0;

@@ -511,7 +511,7 @@ TEST_CASE("Remesher2D: the trigger's hysteresis, and a transferred state exact f
   fill(old_space, s.U[0]);
   s.U[1] = s.U[0];
   for (const auto& x : mesh.coordinates()) s.X[1].push_back(affine(x)), s.V.push_back(affine(x));
-  transfer_levels(s, old_space, *out->transfer);
+  transfer_levels(s, old_space, *out->transfer, out->mesh.coordinates());
   VecX exact;
   fill(new_space, exact);
   // inside the old mesh the transfer is exact; new nodes on the circle lie O(h^2) outside it
@@ -531,6 +531,12 @@ TEST_CASE("Remesher2D: the trigger's hysteresis, and a transferred state exact f
   CHECK(worst_x < 1e-12);
   CHECK(s.U[1] == s.U[0]);
   CHECK(s.X[2].empty());  // a level not yet taken stays empty
+  // a mesh at rest stays at rest: the past positions go as displacements from X^n, so every new
+  // node, those on the circle outside the old polygon too, has X^{n-1} = its own position
+  FlowState<2, RigidBodyTraits<2>> rest;
+  rest.X[1] = mesh.coordinates();
+  transfer_levels(rest, old_space, *out->transfer, out->mesh.coordinates());
+  CHECK(rest.X[1] == out->mesh.coordinates());
 }
 
 // ---- the flow state in a checkpoint ------------------------------------------------------------

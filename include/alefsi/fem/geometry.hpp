@@ -136,6 +136,19 @@ class QuadraticGeometry {
     for (Index k = start_[std::size_t(e)]; k < start_[std::size_t(e) + 1]; ++k) curved_[std::size_t(edge_cells_[std::size_t(k)])] = 1;
   }
 
+  /// Whether edge e's point was set (else it is the midpoint), and its coordinates in the edge's
+  /// frame: what places it. A checkpoint keeps them, and `set_frame_coefficients` puts a point
+  /// back bit for bit (through `set_edge_point` it would pass through a frame's inverse).
+  bool point_set(Index e) const { return moved_.at(std::size_t(e)) != 0; }
+  const Vec<D>& frame_coefficients(Index e) const { return coef_.at(std::size_t(e)); }
+  void set_frame_coefficients(Index e, const Vec<D>& k) {
+    ALEFSI_CHECK_ARG(e >= 0 && e < mesh_->n_edges(), "e", "edge ", e, " out of range [0, ", mesh_->n_edges(), ")");
+    ALEFSI_CHECK_ARG(k.allFinite(), "k", "edge ", e, ": the frame coefficients must be finite");
+    coef_[std::size_t(e)] = k;
+    moved_[std::size_t(e)] = 1;
+    for (Index j = start_[std::size_t(e)]; j < start_[std::size_t(e) + 1]; ++j) curved_[std::size_t(edge_cells_[std::size_t(j)])] = 1;
+  }
+
   /// The point of edge e when the mesh nodes are at X (one position per node).
   Vec<D> edge_point(Index e, const std::vector<Vec<D>>& X) const {
     if (!moved_[std::size_t(e)]) {  // the midpoint, without the frame (most edges)
@@ -272,10 +285,11 @@ class QuadraticGeometry {
 };
 
 /// Places the point of every edge lying on a boundary facet with tag `tag` at onto(midpoint)
-/// (a projection onto the exact curve or surface), then checks the cells it curved.
-/// Returns the number of edges moved. Throws InvalidArgument when no facet has the tag.
+/// (a projection onto the exact curve or surface), then checks the cells it curved (unless
+/// `check` is false: the caller checks later). Returns the number of edges moved. Throws
+/// InvalidArgument when no facet has the tag.
 template <int D, class Projector>
-Index project_boundary_edges(QuadraticGeometry<D>& g, int tag, Projector&& onto) {
+Index project_boundary_edges(QuadraticGeometry<D>& g, int tag, Projector&& onto, bool check = true) {
   const auto& mesh = g.mesh();
   const std::vector<Index> edges = mesh.boundary_edges(tag);
   ALEFSI_CHECK_ARG(!edges.empty(), "tag", "no boundary facet has tag ", tag);
@@ -283,7 +297,7 @@ Index project_boundary_edges(QuadraticGeometry<D>& g, int tag, Projector&& onto)
     const Vec<D> m = 0.5 * (mesh.node(mesh.edge(e)[0]) + mesh.node(mesh.edge(e)[1]));
     g.set_edge_point(e, onto(m));
   }
-  g.check_all();
+  if (check) g.check_all();
   return Index(edges.size());
 }
 

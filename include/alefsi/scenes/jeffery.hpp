@@ -17,6 +17,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <type_traits>
+#include <utility>
 
 #include "alefsi/core/error.hpp"
 #include "alefsi/core/types.hpp"
@@ -35,6 +37,9 @@ struct Jeffery {
   Real h_far = 1;             ///< largest mesh size
   Real grading = 0.25;        ///< growth of the size with the distance from the circle of radius a
   bool curved = true;         ///< isoparametric P2 cells on the ellipse and the container
+  /// `follow_orbit`: remesh (sim/remesher2d.hpp, this scene's size function, the container's
+  /// circle as the wall) when the worst cell quality falls below this; 0: never.
+  Real remesh_quality = 0;
 
   using Flow = AleFlow<FlowConfig<2, TaylorHood, BDF2_BDF2E, UnsteadyStokes>>;
 
@@ -54,10 +59,15 @@ struct Jeffery {
   Mesh<2> mesh(Real phi) const {
     validate();
     MesherOptions opt;
-    opt.size = [s = *this](const Vec<2>& x) {
+    opt.size = size();
+    return generate_mesh(Domain2D{Circle{Vec<2>::Zero(), container, 2}, {ellipse(phi)}}, opt);
+  }
+  /// The mesh size: h_body within the circle of radius max(a, b), growing by `grading` per unit
+  /// distance up to h_far.
+  SizeFunction size() const {
+    return [s = *this](const Vec<2>& x) {
       return std::min(s.h_far, s.h_body + s.grading * std::max(Real(0), x.norm() - std::max(s.a, s.b)));
     };
-    return generate_mesh(Domain2D{Circle{Vec<2>::Zero(), container, 2}, {ellipse(phi)}}, opt);
   }
 
   /// The ellipse's quasi-static spin at orientation phi: Stokes flow (unsteady Stokes with
@@ -77,20 +87,29 @@ struct Jeffery {
   /// the body spins at once at spin(phi0) (from rest, the first explicit position update would
   /// lag the orbit by dt w). `visit(t, phi, worst_quality)` after every step. Without remeshing
   /// a quarter turn keeps the cells above quality 0.28 (b / a = 1/2, h_body 0.1); a half turn
-  /// brings them to 0.09.
+  /// brings them to 0.09. With `remesh_quality` > 0 the mesh is adapted when its worst cell
+  /// falls below it (the curved edge points placed anew on the ellipse where the body is then).
+  /// `visit` may take the flow as a fourth argument. Returns the number of remeshes.
   template <class Visit>
-  void follow_orbit(Real phi0, Real dt, Real t_end, Visit&& visit) const {
+  Index follow_orbit(Real phi0, Real dt, Real t_end, Visit&& visit) const {
     validate();
     ALEFSI_CHECK_ARG(dt > 0 && t_end >= dt && std::isfinite(t_end), "dt, t_end", "need 0 < dt <= t_end, got ", dt,
                      ", ", t_end);
+    ALEFSI_CHECK_ARG(remesh_quality >= 0 && remesh_quality < 1, "remesh_quality", "must be in [0, 1), got ",
+                     remesh_quality);
     const Real w0 = spin(phi0);
     Flow flow(mesh(phi0), FlowOptions{1e-18, mu});
     set_up(flow, phi0, w0);
+    if (remesh_quality > 0) set_remeshing(flow);
     const long n = std::lround(t_end / dt);
     for (long i = 0; i < n; ++i) {
       flow.step(dt);
-      visit(flow.time(), flow.body_angle(0), flow.worst_quality());
+      if constexpr (std::is_invocable_v<Visit&, Real, Real, Real, const Flow&>)
+        visit(flow.time(), flow.body_angle(0), flow.worst_quality(), std::as_const(flow));
+      else
+        visit(flow.time(), flow.body_angle(0), flow.worst_quality());
     }
+    return flow.stats().remeshes;
   }
 
   /// The orbit of d phi / dt = w0 cos^2 phi + w1 sin^2 phi (w0, w1 < 0: the spins at phi = 0
@@ -125,6 +144,17 @@ struct Jeffery {
       flow.curve_boundary(1, [e = ellipse(phi)](const Vec<2>& x) { return e.radial_projection(x); });
       flow.curve_boundary(2, onto_sphere<2>(Vec<2>::Zero(), container));
     }
+  }
+
+  /// Remeshing on `flow` (a mesh of `mesh(phi)`) when the worst cell quality falls below
+  /// `remesh_quality` (> 0): this scene's size function, the container's circle as the wall.
+  void set_remeshing(Flow& flow) const {
+    ALEFSI_CHECK_ARG(remesh_quality > 0 && remesh_quality < 1, "remesh_quality", "must be in (0, 1), got ",
+                     remesh_quality);
+    flow.set_remeshing({.trigger_quality = remesh_quality,
+                        .walls = {Circle{Vec<2>::Zero(), container, 2}},
+                        .size = [h = size()](const auto&) { return h; },
+                        .adapt = {}});
   }
 
   /// Jeffery's spin at orientation phi (unbounded flow).

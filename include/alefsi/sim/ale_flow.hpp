@@ -200,6 +200,9 @@ class AleFlow {
     require_not_started("add_body");
     ALEFSI_CHECK_ARG(!dirichlet_.count(BodyModel::tag(body)), "body.tag", "tag ", BodyModel::tag(body),
                      " already has a Dirichlet velocity");
+    for (const auto& c : curved_)  // its projection must be known in the body's frame
+      ALEFSI_CHECK_ARG(c.tag != BodyModel::tag(body), "body.tag", "curve_boundary(", c.tag,
+                       ") was called before add_body: add the body first");
     return bodies_.add(body, mesh_, time(), state_.bodies);
   }
   void set_initial_velocity(const std::function<Vec<D>(const Vec<D>&)>& u0, Real t0 = 0) {
@@ -215,24 +218,41 @@ class AleFlow {
   /// disk or sphere, a body's or a wall's) and then follows the edge's nodes (fem/geometry.hpp):
   /// a body's surface moves it rigidly with the body, a fixed wall keeps it. The kernel
   /// integrates the curved cells through their quadratic map, boundary data and the bodies'
-  /// rigid link u = H(x) Z are taken at the edge points. Before the first step; not with
-  /// remeshing or checkpoints yet (refused: both would need the edge points carried over).
+  /// rigid link u = H(x) Z are taken at the edge points (so is an initial field set after it).
+  /// Before the first step, and after `add_body` for a body's surface: `onto` is the projection
+  /// at the body's pose as added, and a remesh applies it to the new mesh's edges at the body's
+  /// pose then (moved by the body's rigid map; the state is transferred through the curved
+  /// cells). A checkpoint keeps the points: a flow that loads it is given the same
+  /// `curve_boundary` calls (refused otherwise) and takes the points from the checkpoint. A tag
+  /// with no boundary facet is refused here; a cell the points fold (MeshError) when the flow
+  /// is prepared (`prepare`, the first step), so that a restart's mesh, curved here at the
+  /// pose as added, is judged only on the checkpoint's points.
   template <class Onto>
   void curve_boundary(int tag, Onto&& onto)
     requires(Space::VelocityElement::degree == 2)
   {
     require_not_started("curve_boundary");
-    ALEFSI_CHECK_ARG(!remesher_, "tag", "curved boundaries are not supported with remeshing yet");
-    if (!geometry_) geometry_ = std::make_unique<QuadraticGeometry<D>>(mesh_);
-    project_boundary_edges(*geometry_, tag, std::forward<Onto>(onto));
-    disc_.set_geometry(geometry_.get());
+    ALEFSI_CHECK_ARG(!mesh_.boundary_edges(tag).empty(), "tag", "no boundary facet has tag ", tag);
+    for (const auto& c : curved_) ALEFSI_CHECK_ARG(c.tag != tag, "tag", "tag ", tag, " is curved already");
+    CurvedBoundary c{tag, std::function<Vec<D>(const Vec<D>&)>(std::forward<Onto>(onto))};
+    if (const int k = bodies_.index_of(tag); k >= 0) {
+      c.body = k;
+      c.centre = state_.bodies[std::size_t(k)].centre[0];
+      c.orientation = state_.bodies[std::size_t(k)].orientation[0];
+    }
+    if (!geometry_) {
+      geometry_ = std::make_unique<QuadraticGeometry<D>>(mesh_);
+      disc_.set_geometry(geometry_.get());
+    }
+    project_boundary_edges(*geometry_, tag, c.onto, false);
+    geometry_checked_ = false;
+    curved_.push_back(std::move(c));
   }
   /// The curved geometry (null: straight cells).
   const QuadraticGeometry<D>* geometry() const { return geometry_.get(); }
 
   /// Remeshing in the time loop by `remesher` (sim/remesher.hpp); may be set between steps.
   void set_remesher(std::unique_ptr<Remesher<D>> remesher) {
-    ALEFSI_CHECK_ARG(!remesher || !geometry_, "remesher", "curved boundaries are not supported with remeshing yet");
     remesher_ = std::move(remesher);
   }
   /// 2D remeshing (sim/remesher2d.hpp).
@@ -297,7 +317,12 @@ class AleFlow {
   /// overlapping bodies, a surface node off its body's circle or sphere, a slip with a normal
   /// part. The first step calls it; `run()` calls it before it writes any output.
   void prepare() {
-    if (!disc_.constrained()) setup();
+    if (disc_.constrained()) return;
+    if (geometry_ && !geometry_checked_) {  // the points curve_boundary placed
+      geometry_->check_all();
+      geometry_checked_ = true;
+    }
+    setup();
   }
   /// Advances from t^n to t^n + dt. With `control.tolerance` > 0, a regular step whose error
   /// estimate exceeds it is rejected before anything changes: `StepRejected` is thrown and the
@@ -331,10 +356,25 @@ class AleFlow {
     ALEFSI_CHECK_ARG(remesher_ != nullptr, "remesh", "call set_remeshing (or set_remesher) first");
     auto out = remesher_->adapt(mesh_, bodies_.remesh_bodies(state_.bodies), Space::VelocityElement::degree);
     if (!out) return false;
-    transfer_levels(state_, space(), *out->transfer);
+    // curved boundaries: the new mesh's edge points first (a cell they fold is refused before
+    // anything changes), then the transfer through the old and new curved cells
+    std::unique_ptr<MeshTransfer<D>> curved_transfer;
+    if (geometry_) {
+      QuadraticGeometry<D> g(out->mesh);
+      curve(g, state_.bodies);
+      curved_transfer = std::make_unique<LagrangeTransfer<D>>(mesh_, out->mesh, Space::VelocityElement::degree,
+                                                              geometry_->edge_points(), g.edge_points());
+    }
+    transfer_levels(state_, space(), curved_transfer ? *curved_transfer : *out->transfer, out->mesh.coordinates());
     state_.X[0] = out->mesh.coordinates();
     mesh_ = std::move(out->mesh);
     disc_.rebuild(mesh_);
+    if constexpr (Space::VelocityElement::degree == 2)  // (curved cells are Taylor–Hood's)
+      if (geometry_) {
+        geometry_ = std::make_unique<QuadraticGeometry<D>>(mesh_);
+        curve(*geometry_, state_.bodies);
+        disc_.set_geometry(geometry_.get());
+      }
     bodies_.attach(mesh_);
     bodies_.reset_surface(mesh_, state_.bodies, state_.X);
     setup();
@@ -351,12 +391,23 @@ class AleFlow {
   /// `read_checkpoint_mesh<D>(file)`, given the same configuration (options, boundary data,
   /// bodies, remeshing, contacts) and then `load_checkpoint(file)`, continues bit for bit.
   void save_checkpoint(const std::filesystem::path& file) const {
-    ALEFSI_CHECK_ARG(!geometry_, "file", "flows with curved boundaries cannot be checkpointed yet (", file.string(),
-                     ")");
     CheckpointWriter w(file);
     write_config(w);
     write_mesh(w, mesh_);
     write_state(w, state_, bodies_.tags());
+    // the curved boundaries' tags and their points
+    w.section("curved");
+    w.put_vector(curved_tags());
+    std::vector<Index> edges;
+    std::vector<Real> coef;
+    if (geometry_)
+      for (Index e = 0; e < mesh_.n_edges(); ++e)
+        if (geometry_->point_set(e)) {
+          edges.push_back(e);
+          for (int i = 0; i < D; ++i) coef.push_back(geometry_->frame_coefficients(e)[i]);
+        }
+    w.put_vector(edges);
+    w.put_vector(coef);
     // the factorisations a reused solve would precondition with (empty: none)
     auto put_solver = [&w](const char* name, const auto& lin) {
       w.section(name);
@@ -381,11 +432,35 @@ class AleFlow {
       r.fail("the flow's mesh is not the checkpoint's (build it with read_checkpoint_mesh)");
     State s = state_;
     read_state(r, s, bodies_.tags(), space().n_field());
+    r.section("curved");
+    if (const auto tags = r.get_vector<int>("curved tags"); tags != curved_tags())
+      r.fail("written with curved boundaries on " + std::to_string(tags.size()) +
+             " tags, this flow has other curve_boundary calls (" + std::to_string(curved_.size()) + ")");
+    const auto edges = r.get_vector<Index>("curved edges");
+    const auto coef = r.get_vector<Real>("frame coefficients");
+    if (coef.size() != edges.size() * std::size_t(D)) r.fail("the curved edges and their coefficients differ in size");
+    for (Index e : edges)
+      if (e < 0 || e >= mesh_.n_edges()) r.fail("a curved edge is out of the mesh's range");
     const KeptFactors flow_factors = read_kept_factors(r, "solver");
     const KeptFactors motion_factors = read_kept_factors(r, "mesh-velocity solver");
     r.finish();
     s.X[0] = mesh_.coordinates();
+    // the points as written, bit for bit (curve_boundary placed them at the bodies' poses as
+    // added, not at the checkpoint's)
+    std::unique_ptr<QuadraticGeometry<D>> g;
+    if (!curved_.empty()) {
+      g = std::make_unique<QuadraticGeometry<D>>(mesh_);
+      for (std::size_t i = 0; i < edges.size(); ++i)
+        g->set_frame_coefficients(edges[i], Eigen::Map<const Vec<D>>(coef.data() + D * i));
+      g->check_all();
+    }
     state_ = std::move(s);
+    if constexpr (Space::VelocityElement::degree == 2)
+      if (g) {
+        geometry_ = std::move(g);
+        disc_.set_geometry(geometry_.get());
+        geometry_checked_ = true;
+      }
     setup();
     // in parts (MPI) the flow's factors are not reused, and a whole matrix's kept factors would
     // not fit a part's pattern: the first solve factorises afresh
@@ -397,6 +472,47 @@ class AleFlow {
   }
 
  private:
+  // A curved boundary as `curve_boundary` was given it: the projection, and for a body's
+  // surface the body's pose then.
+  struct CurvedBoundary {
+    int tag = 0;
+    std::function<Vec<D>(const Vec<D>&)> onto;
+    int body = -1;  // the body with this tag (-1: a wall)
+    Vec<D> centre = Vec<D>::Zero();
+    BodyOrientation orientation{};
+  };
+  // Every curved boundary's edge points on g's mesh (at its nodes now), a body's projection
+  // carried from its pose when given to its pose at t^n in `states` (as given at that pose).
+  void curve(QuadraticGeometry<D>& g, const std::vector<typename BodySystem<D, BodyModel>::State>& states) const {
+    for (const auto& c : curved_) {
+      const std::size_t k = std::size_t(std::max(c.body, 0));
+      if (c.body < 0 || same_pose(states[k], c)) {
+        project_boundary_edges(g, c.tag, c.onto);
+        continue;
+      }
+      const Vec<D> centre = states[k].centre[0];
+      const BodyOrientation q = states[k].orientation[0];
+      project_boundary_edges(g, c.tag, [&](const Vec<D>& x) -> Vec<D> {
+        const Vec<D> x0 = bodies_.from_model(k, bodies_.to_model(k, x, centre, q), c.centre, c.orientation);
+        return bodies_.from_model(k, bodies_.to_model(k, c.onto(x0), c.centre, c.orientation), centre, q);
+      });
+    }
+  }
+
+  template <class S>
+  static bool same_pose(const S& s, const CurvedBoundary& c) {
+    if (s.centre[0] != c.centre) return false;
+    if constexpr (std::same_as<BodyOrientation, Real>)
+      return s.orientation[0] == c.orientation;
+    else
+      return s.orientation[0].coeffs() == c.orientation.coeffs();
+  }
+  std::vector<int> curved_tags() const {
+    std::vector<int> t;
+    for (const auto& c : curved_) t.push_back(c.tag);
+    return t;
+  }
+
   // The matrices a solver analysed and factorised last, as a checkpoint keeps them.
   struct KeptFactors {
     std::vector<Real> analysed, factored;
@@ -680,6 +796,8 @@ class AleFlow {
   std::unique_ptr<ContactModel<D>> contact_;
   std::unique_ptr<Remesher<D>> remesher_;
   std::unique_ptr<QuadraticGeometry<D>> geometry_;  // curved boundaries (null: straight cells)
+  std::vector<CurvedBoundary> curved_;               // what curves them, for each new mesh
+  bool geometry_checked_ = true;                     // curve_boundary's points checked (prepare)
   NodeVelocities<D> body_nodes_;  // the step's surface node velocities (scratch)
   std::vector<char> body_jacobian_here_;  // in parts: the bodies whose own Jacobian terms this process adds
   BlockCoupling coupling_;  // the contact Jacobian between two bodies, beside the pattern (Newton's)

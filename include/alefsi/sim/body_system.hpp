@@ -99,6 +99,20 @@ class BodySystem {
       if (M::tag(e.data) == tag) return true;
     return false;
   }
+  /// The index of the body with tag `tag`, or -1.
+  int index_of(int tag) const {
+    for (std::size_t k = 0; k < entries_.size(); ++k)
+      if (M::tag(entries_[k].data) == tag) return int(k);
+    return -1;
+  }
+  /// A world point x in body k's model frame (the frame of its surface offsets) when the body
+  /// is at `centre` and `orientation`, and back (`from_model`).
+  Vec<D> to_model(std::size_t k, const Vec<D>& x, const Vec<D>& centre, const Orientation& orientation) const {
+    return M::to_body(x - centre, orientation, entries_.at(k).data);
+  }
+  Vec<D> from_model(std::size_t k, const Vec<D>& r, const Vec<D>& centre, const Orientation& orientation) const {
+    return centre + M::to_world(r, orientation, entries_.at(k).data);
+  }
   /// Surface mesh nodes of body k (sorted).
   const std::vector<Index>& surface_nodes(std::size_t k) const { return entries_.at(k).nodes; }
 

@@ -231,8 +231,6 @@ RunSummary run(Flow& flow, const RunOptions& options) {
   ALEFSI_CHECK_ARG(options.t_end > flow.time(), "t_end", "must exceed the flow's time ", flow.time(), ", got ",
                    options.t_end);
   flow.prepare();  // a scene that cannot run is refused before anything is written
-  ALEFSI_CHECK_ARG(options.checkpoint_every == 0 || options.output.empty() || !flow.geometry(), "checkpoint_every",
-                   "flows with curved boundaries cannot be checkpointed yet: set it to 0");
   // in parts every process writes its VTU piece and learns of the writer's checkpoints, at the
   // same steps (a collective check)
   bool pieces = false;

@@ -9,8 +9,9 @@
 /// `adapt(mesh, bodies, velocity_degree)` returns the new mesh and a `MeshTransfer<D>` from the
 /// old one (or nothing if the adaptation changed nothing), and the flow:
 ///   1. interpolates every history level in the current configuration (`transfer_levels`:
-///      positions X^{n-1}, X^{n-2} and the mesh velocity V^n by P1, the fields U^{n-k} by the
-///      velocity and pressure degrees; the new X^n is the new mesh's nodes);
+///      positions X^{n-1}, X^{n-2} (as displacements from X^n) and the mesh velocity V^n by P1,
+///      the fields U^{n-k} by the velocity and pressure degrees; the new X^n is the new mesh's
+///      nodes);
 ///   2. rebuilds the discretisation on the new topology;
 ///   3. resets each body's surface nodes and surface velocity DOFs, at every level, from its
 ///      exact rigid motion (sim/body_system.hpp), so bodies keep their shape;
@@ -135,23 +136,32 @@ Real worst_quality(const Mesh<D>& mesh) {
 
 /// Step 1 above: every history level of `state` interpolated from `old_space`'s mesh by `T`,
 /// in place. Levels not yet taken (empty) stay empty. X^n is left to the caller (the new
-/// mesh's nodes).
+/// mesh's nodes, `new_nodes`). The past positions are transferred as displacements from the
+/// nodes at t^n, X^{n-k} = x + T(X^{n-k} - X^n)(x) at a new node x: a node that does not move
+/// (a wall's) keeps X^{n-k} = x, where the positions themselves would give a new node on a
+/// curved wall the point of the old chord (or of the old cell's P2 map of its vertices), which
+/// the position formula would then take for a motion towards it and follow.
 template <class State, class Space>
-void transfer_levels(State& state, const Space& old_space, const MeshTransfer<Space::dim>& T) {
+void transfer_levels(State& state, const Space& old_space, const MeshTransfer<Space::dim>& T,
+                     const std::vector<Vec<Space::dim>>& new_nodes) {
   constexpr int D = Space::dim;
   const int kv = Space::VelocityElement::degree, kp = Space::PressureElement::degree;
-  auto move_points = [&](std::vector<Vec<D>>& x) {
+  const std::vector<Vec<D>>& old_nodes = old_space.mesh().coordinates();
+  // x_new + T(x - base) (base: the old nodes) or T(x) (no base)
+  auto move_points = [&](std::vector<Vec<D>>& x, bool displacement) {
     if (x.empty()) return;
+    ALEFSI_ASSERT(!displacement || x.size() == old_nodes.size());
     std::vector<Real> flat(D * x.size());
     for (std::size_t i = 0; i < x.size(); ++i)
-      for (int c = 0; c < D; ++c) flat[D * i + c] = x[i][c];
+      for (int c = 0; c < D; ++c) flat[D * i + c] = x[i][c] - (displacement ? old_nodes[i][c] : Real(0));
     flat = T.apply(flat, D, 1);
+    ALEFSI_ASSERT(flat.size() == D * new_nodes.size());
     x.resize(flat.size() / D);
     for (std::size_t i = 0; i < x.size(); ++i)
-      for (int c = 0; c < D; ++c) x[i][c] = flat[D * i + c];
+      for (int c = 0; c < D; ++c) x[i][c] = flat[D * i + c] + (displacement ? new_nodes[i][c] : Real(0));
   };
-  for (int k = 1; k < state.X.size(); ++k) move_points(state.X[k]);
-  move_points(state.V);
+  for (int k = 1; k < state.X.size(); ++k) move_points(state.X[k], true);
+  move_points(state.V, false);
   for (int k = 0; k < state.U.size(); ++k) {
     VecX& u = state.U[k];
     if (u.size() == 0) continue;

@@ -218,7 +218,10 @@ class FieldTransfer {
       for (Index e : from.cell_edges(c)) {
         const auto& ev = from.edge(e);
         const Vec<D> m = 0.5 * (from.node(ev[0]) + from.node(ev[1]));
-        if ((points[std::size_t(e)] - m).norm() > 1e-12 * from.edge_length(e)) any = curved[std::size_t(c)] = 1;
+        if ((points[std::size_t(e)] - m).norm() > 1e-12 * from.edge_length(e)) {
+          curved[std::size_t(c)] = 1;
+          any = true;
+        }
       }
     return any ? curved : std::vector<char>{};
   }

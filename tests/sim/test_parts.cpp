@@ -136,15 +136,18 @@ void check_body_jacobian(const Space& space, Bodies& bodies, States& states, con
 }  // namespace
 
 namespace {
-// The 2D bodies attached to `mesh` and moved through one BDF2 step of 0.01 from the velocities
-// their states hold: where the step's contacts are found. Returns the step's coefficients.
-StepCoefficients place_after_step(BodySystem<2, RigidBodyTraits<2>>& bodies,
-                                  std::vector<BodyState<2, RigidBodyTraits<2>>>& states, const Mesh<2>& mesh) {
+// The bodies attached to `mesh` and moved through one step of dt by Scheme (first step) from the
+// velocities their states hold: where the step's contacts are found. Returns the step's
+// coefficients.
+template <int D, class Scheme = BDF2_BDF2E>
+StepCoefficients place_after_step(BodySystem<D, RigidBodyTraits<D>>& bodies,
+                                  std::vector<BodyState<D, RigidBodyTraits<D>>>& states, const Mesh<D>& mesh,
+                                  Real dt = 0.01) {
   bodies.attach(mesh);
-  const StepCoefficients c = step_coefficients<BDF2_BDF2E>(0.01, TimeHistory{});
-  NodeVelocities<2> nodes;
-  bodies.mesh_velocity_data(states, mesh.coordinates(), c.extrapolation, 0.01, nodes);
-  std::vector<Vec<2>> x = mesh.coordinates();
+  const StepCoefficients c = step_coefficients<Scheme>(dt, TimeHistory{});
+  NodeVelocities<D> nodes;
+  bodies.mesh_velocity_data(states, mesh.coordinates(), c.extrapolation, dt, nodes);
+  std::vector<Vec<D>> x = mesh.coordinates();
   bodies.advance(states, c, x);
   return c;
 }
@@ -275,12 +278,7 @@ TEST_CASE("body rows: the body blocks of add_rows match finite differences (2D w
     Vec<6> Z;
     Z << 0.1, -0.2, 0.3, 1.5, -0.7, 2.0;
     states[0].velocity.fill(Z);
-    bodies.attach(mesh);
-    const StepCoefficients c = step_coefficients<BDF3_BDF3E>(0.02, TimeHistory{});
-    NodeVelocities<3> nodes;
-    bodies.mesh_velocity_data(states, mesh.coordinates(), c.extrapolation, 0.02, nodes);
-    std::vector<Vec<3>> x = mesh.coordinates();
-    bodies.advance(states, c, x);
+    const StepCoefficients c = place_after_step<3, BDF3_BDF3E>(bodies, states, mesh, 0.02);
     NoContact<3> none;
     check_body_jacobian<3>(space, bodies, states, none, c, Vec<3>(0, 0, -1));
 

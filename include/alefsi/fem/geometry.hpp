@@ -132,8 +132,7 @@ class QuadraticGeometry {
     ALEFSI_CHECK_ARG(e >= 0 && e < mesh_->n_edges(), "e", "edge ", e, " out of range [0, ", mesh_->n_edges(), ")");
     const Frame F = frame(e, mesh_->coordinates());
     coef_[std::size_t(e)] = F.axes.inverse() * (x - F.origin);
-    moved_[std::size_t(e)] = 1;
-    for (Index k = start_[std::size_t(e)]; k < start_[std::size_t(e) + 1]; ++k) curved_[std::size_t(edge_cells_[std::size_t(k)])] = 1;
+    mark_moved(e);
   }
 
   /// Whether edge e's point was set (else it is the midpoint), and its coordinates in the edge's
@@ -145,8 +144,7 @@ class QuadraticGeometry {
     ALEFSI_CHECK_ARG(e >= 0 && e < mesh_->n_edges(), "e", "edge ", e, " out of range [0, ", mesh_->n_edges(), ")");
     ALEFSI_CHECK_ARG(k.allFinite(), "k", "edge ", e, ": the frame coefficients must be finite");
     coef_[std::size_t(e)] = k;
-    moved_[std::size_t(e)] = 1;
-    for (Index j = start_[std::size_t(e)]; j < start_[std::size_t(e) + 1]; ++j) curved_[std::size_t(edge_cells_[std::size_t(j)])] = 1;
+    mark_moved(e);
   }
 
   /// The point of edge e when the mesh nodes are at X (one position per node).
@@ -253,6 +251,11 @@ class QuadraticGeometry {
   }
 
  private:
+  // Edge e's point is set: the cells around it are curved.
+  void mark_moved(Index e) {
+    moved_[std::size_t(e)] = 1;
+    for (Index k = start_[std::size_t(e)]; k < start_[std::size_t(e) + 1]; ++k) curved_[std::size_t(edge_cells_[std::size_t(k)])] = 1;
+  }
   Vec<D> midpoint(Index e) const { return 0.5 * (mesh_->node(mesh_->edge(e)[0]) + mesh_->node(mesh_->edge(e)[1])); }
 
   // The frame of edge e at node positions X: origin m, axes (d, d^perp) or (d, f, d x f / |d|).

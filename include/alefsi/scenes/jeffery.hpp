@@ -50,6 +50,8 @@ struct Jeffery {
                      container);
     ALEFSI_CHECK_ARG(h_body > 0 && h_far >= h_body && grading > 0, "h_body, h_far, grading",
                      "need 0 < h_body <= h_far and grading > 0");
+    ALEFSI_CHECK_ARG(remesh_quality >= 0 && remesh_quality < 1, "remesh_quality", "must be in [0, 1), got ",
+                     remesh_quality);
   }
 
   /// The ellipse at orientation phi (tag 1).
@@ -95,8 +97,6 @@ struct Jeffery {
     validate();
     ALEFSI_CHECK_ARG(dt > 0 && t_end >= dt && std::isfinite(t_end), "dt, t_end", "need 0 < dt <= t_end, got ", dt,
                      ", ", t_end);
-    ALEFSI_CHECK_ARG(remesh_quality >= 0 && remesh_quality < 1, "remesh_quality", "must be in [0, 1), got ",
-                     remesh_quality);
     const Real w0 = spin(phi0);
     Flow flow(mesh(phi0), FlowOptions{1e-18, mu});
     set_up(flow, phi0, w0);

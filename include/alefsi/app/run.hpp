@@ -32,7 +32,7 @@ struct RunFiles {
   Options& add_to(Options& opt) {
     return opt.add("output", output, "folder for bodies.csv, VTU and checkpoints")
         .add("vtu-every", vtu_every, "a VTU file every this many steps (0: none)")
-        .add("checkpoint-every", checkpoint_every, "a checkpoint every this many steps (0: only at the end)")
+        .add("checkpoint-every", checkpoint_every, "a checkpoint every this many steps and at the end (0: none)")
         .flag("restart", restart, "continue from <output>/checkpoint.bin");
   }
   void apply(RunOptions& r) const {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <numbers>
 #include <string>
 
@@ -20,6 +21,7 @@
 #include "alefsi/scenes/jeffery.hpp"
 #include "alefsi/sim/ale_flow.hpp"
 #include "alefsi/sim/driver.hpp"
+#include "alefsi/sim/remesher2d.hpp"
 
 using namespace alefsi;
 using std::numbers::pi;
@@ -802,6 +804,99 @@ TEST_CASE("curved cells through remeshes: a checkpoint between two of them resta
   }
   std::filesystem::remove(file);
   std::filesystem::remove(file.string() + ".prev");
+}
+
+namespace {
+// Remeshing whose own trigger never fires (Remesher2D's adaptation): every remesh of a flow
+// that has it is the curved cells' trigger's.
+class CurvedTriggerOnly final : public Remesher<2> {
+ public:
+  explicit CurvedTriggerOnly(RemeshOptions opt) : inner_(std::move(opt)) {}
+  bool enabled() const override { return true; }
+  RemeshMemory measure(const Mesh<2>& mesh, const std::vector<RemeshBody<2>>& bodies) const override {
+    return inner_.measure(mesh, bodies);
+  }
+  bool needed(const Mesh<2>&, const std::vector<RemeshBody<2>>&, const RemeshMemory&) const override {
+    return false;
+  }
+  std::optional<Remeshed<2>> adapt(const Mesh<2>& mesh, const std::vector<RemeshBody<2>>& bodies,
+                                   int velocity_degree) override {
+    return inner_.adapt(mesh, bodies, velocity_degree);
+  }
+
+ private:
+  Remesher2D inner_;
+};
+}  // namespace
+
+TEST_CASE("a disk driven onto a floor: a curved cell the motion folds is refused, and the curved cells' trigger "
+          "remeshes before it",
+          "[curved][remesh][quick]") {
+  // A disk (R = 0.4, h = 0.2 at it: edge points a sagitta of about h^2 / (8R) = 0.0125 off
+  // their chords) driven at unit speed towards the floor of a 2 x 2 box, elasticity moving the
+  // mesh: the cells beneath it flatten, their edge points stay on the circle, and a curved
+  // cell's map folds long before a straight cell inverts.
+  using Flow = AleFlow<FlowConfig<2, TaylorHood, BDF2_BDF2E>>;
+  const Real R = 0.4, dt = 0.01;
+  const Circle disk{Vec<2>(1, 1), R, 5};
+  auto make = [&] {
+    MesherOptions mo;
+    mo.size = graded_size({disk}, 0.2, 0.4);
+    auto f = std::make_unique<Flow>(generate_mesh(Domain2D{channel_outline(2, 2), {disk}}, mo), FlowOptions{1, 1});
+    for (int t : {1, 2, 3, 4}) f->set_velocity(t, [](const Vec<2>&, Real) { return Vec<2>(0, 0); });
+    RigidBody2D body = disk_body(disk.tag, disk.centre, R, 1);
+    body.prescribed = [](Real) { return Vec<3>(0, -1, 0); };
+    f->add_body(body);
+    f->curve_boundary(disk.tag, onto_sphere<2>(disk.centre, R));
+    return f;
+  };
+  auto gap = [&](const Flow& f) { return f.body_centre(0)[1] - R; };
+  // without remeshing: refused with a MeshError naming the curved cell, the flow left at t^n
+  Real gap_fold = 0;
+  {
+    auto f = make();
+    Real t_before = 0;
+    try {
+      for (int n = 0; n < 60; ++n) {
+        t_before = f->time();
+        f->step(dt);
+      }
+      FAIL("no cell folded");
+    } catch (const MeshError& e) {
+      INFO(e.what());
+      CHECK(std::string(e.what()).find("curved cell") != std::string::npos);
+      CHECK(e.entity() == MeshError::Entity::cell);
+    }
+    gap_fold = gap(*f);
+    std::cout << "disk driven onto a floor: a curved cell folds at gap " << gap_fold << " (straight worst quality "
+              << f->worst_quality() << ")\n";
+    CHECK(f->time() == t_before);
+    CHECK(gap_fold > 0.05);             // long before contact
+    CHECK(f->worst_quality() > 0.05);   // and before a straight cell degenerates
+  }
+  // with remeshing that only the curved cells trigger: through that point, to a quarter of it
+  auto f = make();
+  f->set_remesher(std::make_unique<CurvedTriggerOnly>(
+      RemeshOptions{.walls = {channel_outline(2, 2)},
+                    .size = [](const std::vector<Circle>& d) { return graded_size(d, 0.2, 0.4); },
+                    .adapt = {}}));
+  int steps = 0;
+  Real worst = 1;
+  while (gap(*f) > gap_fold / 4) {
+    REQUIRE(steps < 100);
+    f->step(dt);
+    ++steps;
+    worst = std::min(worst, f->geometry()->worst_ratio());
+  }
+  Real off = 0;
+  for (Index e : f->mesh().boundary_edges(disk.tag))
+    off = std::max(off, std::abs((f->geometry()->edge_point(e) - f->body_centre(0)).norm() - R));
+  std::cout << "  with the curved cells' trigger: " << steps << " steps to gap " << gap(*f) << ", " << f->stats().remeshes
+            << " remeshes, worst det J ratio " << worst << ", edge points off the circle by " << off << "\n";
+  CHECK(f->stats().remeshes >= 1);
+  CHECK(f->stats().remeshes < steps / 2);  // the hysteresis: not a remesh every step
+  CHECK(worst > 0.1);
+  CHECK(off < 1e-12);
 }
 
 TEST_CASE("curved boundaries in a flow: what is refused, naming the parameter", "[curved][quick]") {

@@ -249,6 +249,15 @@ class QuadraticGeometry {
     for (Index c = 0; c < mesh_->n_cells(); ++c)
       if (curved(c)) check(c);
   }
+  /// The smallest `jacobian_ratio` over the curved cells (1 with none): how near the map of the
+  /// worst curved cell is to folding. A motion that flattens a curved cell (its edge point kept
+  /// on the curve, the opposite node brought towards the chord) lowers it.
+  Real worst_ratio() const {
+    Real r = 1;
+    for (Index c = 0; c < mesh_->n_cells(); ++c)
+      if (curved(c)) r = std::min(r, jacobian_ratio(c));
+    return r;
+  }
 
  private:
   // Edge e's point is set: the cells around it are curved.

@@ -344,7 +344,8 @@ class AleFlow {
     if (state_.control.steps_since_remesh >= 0) ++state_.control.steps_since_remesh;
     if (remesher_ && remesher_->enabled()) {
       const auto t0 = std::chrono::steady_clock::now();
-      if (remesher_->needed(mesh_, bodies_.remesh_bodies(state_.bodies), state_.remesh)) rep.remeshed = remesh();
+      if (remesher_->needed(mesh_, bodies_.remesh_bodies(state_.bodies), state_.remesh) || curved_due())
+        rep.remeshed = remesh();
       rep.t_remesh = std::chrono::duration<Real>(std::chrono::steady_clock::now() - t0).count();
     }
     return rep;
@@ -355,7 +356,10 @@ class AleFlow {
   bool remesh() {
     ALEFSI_CHECK_ARG(remesher_ != nullptr, "remesh", "call set_remeshing (or set_remesher) first");
     auto out = remesher_->adapt(mesh_, bodies_.remesh_bodies(state_.bodies), Space::VelocityElement::degree);
-    if (!out) return false;
+    if (!out) {  // nothing changed: the curved trigger waits until the cells are 10 % worse
+      if (geometry_) state_.remesh.curved = geometry_->worst_ratio();
+      return false;
+    }
     // curved boundaries: the new mesh's edge points first (a cell they fold is refused before
     // anything changes), then the transfer through the old and new curved cells
     std::unique_ptr<MeshTransfer<D>> curved_transfer;
@@ -382,8 +386,17 @@ class AleFlow {
     ++state_.stats.remeshes;
     state_.control.steps_since_remesh = 0;
     state_.remesh = remesher_->measure(mesh_, bodies_.remesh_bodies(state_.bodies));
+    if (geometry_) state_.remesh.curved = geometry_->worst_ratio();
     return true;
   }
+  /// With remeshing, a curved cell whose map has come this near to folding (smallest
+  /// det J / det J_affine, `QuadraticGeometry::jacobian_ratio`) triggers a remesh, as a cell's
+  /// quality triggers the remesher: the motion flattens the cells between a curved surface and
+  /// another boundary (a body landing on a wall) while their edge points stay on the curve. Like
+  /// the quality, with hysteresis: once the last remesh left the ratio lower, when it is 10 %
+  /// lower again. A step that folds a curved cell (ratio 0.1, `QuadraticGeometry::check`) is
+  /// rejected with a MeshError naming the cell.
+  static constexpr Real curved_trigger = 0.3;
 
   // ---- checkpoints ---------------------------------------------------------------------------
   /// Writes the whole state at t^n (configuration, mesh, flow state) to `file`, atomically;
@@ -506,6 +519,10 @@ class AleFlow {
       return s.orientation[0] == c.orientation;
     else
       return s.orientation[0].coeffs() == c.orientation.coeffs();
+  }
+  // The curved cells' remesh trigger (curved_trigger).
+  bool curved_due() const {
+    return geometry_ && geometry_->worst_ratio() < std::min(curved_trigger, 0.9 * state_.remesh.curved);
   }
   std::vector<int> curved_tags() const {
     std::vector<int> t;
@@ -633,6 +650,7 @@ class AleFlow {
     const std::vector<Vec<D>> Xth = flow_geometry(g.Xn1, s.X[0], c.theta);
     mesh_.set_coordinates(Xth);
     try {
+      if (geometry_) geometry_->check_all();  // curved cells the motion folded (MeshError)
       // 4. the flow at n+theta
       const VecX u = solve_flow(c, t1, g, Xth, rep);
       VecX field = disc_.constraints().expand(u);
@@ -646,6 +664,7 @@ class AleFlow {
                              e);
       }
       mesh_.set_coordinates(g.Xn1);
+      if (geometry_ && c.theta != 1) geometry_->check_all();
       // 5. the new level
       bodies_.finish(s.bodies, c, disc_.constraints(), u, t1, gravity_);
       s.U.push(std::move(field));

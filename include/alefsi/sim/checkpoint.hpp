@@ -3,7 +3,7 @@
 /// Binary checkpoint files: the exact state of a run, so that a restart continues bit for bit,
 /// and a file that is not exactly what was written is refused.
 ///
-/// Format (version 6; host byte order, doubles bit for bit): the 8-byte magic "ALEFSICK", a
+/// Format (version 7; host byte order, doubles bit for bit): the 8-byte magic "ALEFSICK", a
 /// uint32 version, then named sections, each
 ///     uint32 name length | name | uint64 payload length | payload | uint32 CRC-32 of name + payload
 /// with the payload a sequence of scalars and length-prefixed (uint64) arrays; the last section
@@ -47,7 +47,7 @@ inline constexpr char checkpoint_magic[9] = "ALEFSICK";
 /// analysis and factorisation a reused solve preconditions with); 5: the same for the
 /// mesh-velocity (elasticity) solver, section "mesh-velocity solver"; 6: section "curved", the
 /// curved boundaries' tags and their edge points' frame coefficients.
-inline constexpr std::uint32_t checkpoint_version = 6;
+inline constexpr std::uint32_t checkpoint_version = 7;
 
 namespace detail {
 /// CRC-32 (IEEE 802.3, as zlib and PNG), updated with `n` bytes.

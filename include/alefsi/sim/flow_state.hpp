@@ -173,6 +173,7 @@ void write_state(CheckpointWriter& w, const FlowState<D, M>& s, const std::vecto
   w.put(std::int32_t(s.stats.history_restarts));
   w.put(s.remesh.quality);
   w.put(s.remesh.deviation);
+  w.put(s.remesh.curved);
   w.put(s.control.next_dt);
   w.put(s.control.last_error);
   w.put(std::int32_t(s.control.steps_since_remesh));
@@ -218,6 +219,7 @@ void read_state(CheckpointReader& r, FlowState<D, M>& s, const std::vector<int>&
   s.stats.history_restarts = r.get<std::int32_t>("history restarts");
   s.remesh.quality = r.get<Real>("remesh state");
   s.remesh.deviation = r.get<Real>("remesh state");
+  s.remesh.curved = r.get<Real>("remesh state");
   s.control.next_dt = r.get<Real>("step control");
   s.control.last_error = r.get<Real>("step control");
   s.control.steps_since_remesh = r.get<std::int32_t>("step control");

@@ -48,6 +48,7 @@ struct RemeshBody {
 struct RemeshMemory {
   Real quality = 1;    ///< worst cell quality
   Real deviation = 0;  ///< worst relative deviation of an edge from the size function
+  Real curved = 1;     ///< smallest det J ratio of the curved cells (the flow's own trigger)
 };
 
 /// Interpolation from the old mesh's Lagrange spaces to the new mesh's.

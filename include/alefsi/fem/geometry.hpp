@@ -147,6 +147,35 @@ class QuadraticGeometry {
     mark_moved(e);
   }
 
+  /// Puts edge e's point back at its midpoint; a cell around it stays curved only through
+  /// another set edge.
+  void straighten(Index e) {
+    ALEFSI_CHECK_ARG(e >= 0 && e < mesh_->n_edges(), "e", "edge ", e, " out of range [0, ", mesh_->n_edges(), ")");
+    moved_[std::size_t(e)] = 0;
+    coef_[std::size_t(e)] = Vec<D>::Zero();
+    for (Index k = start_[std::size_t(e)]; k < start_[std::size_t(e) + 1]; ++k) {
+      const Index c = edge_cells_[std::size_t(k)];
+      char any = 0;
+      for (Index f : mesh_->cell_edges(c)) any |= moved_[std::size_t(f)];
+      curved_[std::size_t(c)] = any;
+    }
+  }
+  /// Straightens every set edge of each curved cell whose `jacobian_ratio` is below `floor`,
+  /// until none is (a straight cell's ratio is 1); returns the number of edges straightened.
+  /// Where a mesh is too coarse for a thin gap beside a curve (a body near a wall), its cells
+  /// fall back to the chord there instead of folding.
+  Index straighten_below(Real floor) {
+    Index n = 0;
+    for (bool again = true; again;) {  // (a neighbour's ratio may change with a shared edge)
+      again = false;
+      for (Index c = 0; c < mesh_->n_cells(); ++c)
+        if (curved(c) && jacobian_ratio(c) < floor)
+          for (Index e : mesh_->cell_edges(c))
+            if (moved_[std::size_t(e)]) straighten(e), ++n, again = true;
+    }
+    return n;
+  }
+
   /// The point of edge e when the mesh nodes are at X (one position per node).
   Vec<D> edge_point(Index e, const std::vector<Vec<D>>& X) const {
     if (!moved_[std::size_t(e)]) {  // the midpoint, without the frame (most edges)

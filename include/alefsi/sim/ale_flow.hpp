@@ -360,23 +360,28 @@ class AleFlow {
       if (geometry_) state_.remesh.curved = geometry_->worst_ratio();
       return false;
     }
-    // curved boundaries: the new mesh's edge points first (a cell they fold is refused before
-    // anything changes), then the transfer through the old and new curved cells
+    // curved boundaries: the new mesh's edge points first, then the transfer through the old
+    // and new curved cells. A cell the points would bring within curved_trigger of folding
+    // keeps its edges straight (`straighten_below`): where the new mesh is too coarse for a
+    // thin gap beside a curve (a body near a wall), the chord instead of a folded map.
     std::unique_ptr<MeshTransfer<D>> curved_transfer;
+    std::optional<QuadraticGeometry<D>> g;
     if (geometry_) {
-      QuadraticGeometry<D> g(out->mesh);
-      curve(g, state_.bodies);
+      g.emplace(out->mesh);
+      curve(*g, state_.bodies, false);
+      state_.stats.straightened += g->straighten_below(curved_trigger);
       curved_transfer = std::make_unique<LagrangeTransfer<D>>(mesh_, out->mesh, Space::VelocityElement::degree,
-                                                              geometry_->edge_points(), g.edge_points());
+                                                              geometry_->edge_points(), g->edge_points());
     }
     transfer_levels(state_, space(), curved_transfer ? *curved_transfer : *out->transfer, out->mesh.coordinates());
     state_.X[0] = out->mesh.coordinates();
     mesh_ = std::move(out->mesh);
     disc_.rebuild(mesh_);
     if constexpr (Space::VelocityElement::degree == 2)  // (curved cells are Taylor–Hood's)
-      if (geometry_) {
+      if (geometry_) {  // g's points, on the moved mesh (the same nodes)
         geometry_ = std::make_unique<QuadraticGeometry<D>>(mesh_);
-        curve(*geometry_, state_.bodies);
+        for (Index e = 0; e < mesh_.n_edges(); ++e)
+          if (g->point_set(e)) geometry_->set_frame_coefficients(e, g->frame_coefficients(e));
         disc_.set_geometry(geometry_.get());
       }
     bodies_.attach(mesh_);
@@ -394,8 +399,9 @@ class AleFlow {
   /// quality triggers the remesher: the motion flattens the cells between a curved surface and
   /// another boundary (a body landing on a wall) while their edge points stay on the curve. Like
   /// the quality, with hysteresis: once the last remesh left the ratio lower, when it is 10 %
-  /// lower again. A step that folds a curved cell (ratio 0.1, `QuadraticGeometry::check`) is
-  /// rejected with a MeshError naming the cell.
+  /// lower again. The new mesh's cells below this ratio keep their edges straight
+  /// (`FlowStats::straightened` counts them). A step that folds a curved cell (ratio 0.1,
+  /// `QuadraticGeometry::check`) is rejected with a MeshError naming the cell.
   static constexpr Real curved_trigger = 0.3;
 
   // ---- checkpoints ---------------------------------------------------------------------------
@@ -496,19 +502,24 @@ class AleFlow {
   };
   // Every curved boundary's edge points on g's mesh (at its nodes now), a body's projection
   // carried from its pose when given to its pose at t^n in `states` (as given at that pose).
-  void curve(QuadraticGeometry<D>& g, const std::vector<typename BodySystem<D, BodyModel>::State>& states) const {
+  // With `check`, a cell the points fold is refused (MeshError).
+  void curve(QuadraticGeometry<D>& g, const std::vector<typename BodySystem<D, BodyModel>::State>& states,
+             bool check = true) const {
     for (const auto& c : curved_) {
       const std::size_t k = std::size_t(std::max(c.body, 0));
       if (c.body < 0 || same_pose(states[k], c)) {
-        project_boundary_edges(g, c.tag, c.onto);
+        project_boundary_edges(g, c.tag, c.onto, check);
         continue;
       }
       const Vec<D> centre = states[k].centre[0];
       const BodyOrientation q = states[k].orientation[0];
-      project_boundary_edges(g, c.tag, [&](const Vec<D>& x) -> Vec<D> {
-        const Vec<D> x0 = bodies_.from_model(k, bodies_.to_model(k, x, centre, q), c.centre, c.orientation);
-        return bodies_.from_model(k, bodies_.to_model(k, c.onto(x0), c.centre, c.orientation), centre, q);
-      });
+      project_boundary_edges(
+          g, c.tag,
+          [&](const Vec<D>& x) -> Vec<D> {
+            const Vec<D> x0 = bodies_.from_model(k, bodies_.to_model(k, x, centre, q), c.centre, c.orientation);
+            return bodies_.from_model(k, bodies_.to_model(k, c.onto(x0), c.centre, c.orientation), centre, q);
+          },
+          check);
     }
   }
 

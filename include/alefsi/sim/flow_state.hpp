@@ -64,6 +64,8 @@ struct StepControlMemory {
 /// What the flow did so far (for logs).
 struct FlowStats {
   int steps = 0, remeshes = 0, history_restarts = 0;
+  /// Curved edges that remeshes left straight (their cells' maps too near to folding).
+  Index straightened = 0;
   int contacts = 0;  ///< active contacts in the last step (not checkpointed)
 };
 
@@ -171,6 +173,7 @@ void write_state(CheckpointWriter& w, const FlowState<D, M>& s, const std::vecto
   w.put(std::int32_t(s.stats.steps));
   w.put(std::int32_t(s.stats.remeshes));
   w.put(std::int32_t(s.stats.history_restarts));
+  w.put(std::int64_t(s.stats.straightened));
   w.put(s.remesh.quality);
   w.put(s.remesh.deviation);
   w.put(s.remesh.curved);
@@ -217,6 +220,8 @@ void read_state(CheckpointReader& r, FlowState<D, M>& s, const std::vector<int>&
   s.stats.steps = r.get<std::int32_t>("steps");
   s.stats.remeshes = r.get<std::int32_t>("remeshes");
   s.stats.history_restarts = r.get<std::int32_t>("history restarts");
+  s.stats.straightened = Index(r.get<std::int64_t>("straightened edges"));
+  if (s.stats.straightened < 0) r.fail("negative number of straightened edges");
   s.remesh.quality = r.get<Real>("remesh state");
   s.remesh.deviation = r.get<Real>("remesh state");
   s.remesh.curved = r.get<Real>("remesh state");

@@ -11,7 +11,7 @@
 // (0.2, 2.4), major axis at --angle (default 45 degrees) from the horizontal; fluid density 1,
 // viscosity 0.01 g/(cm s); g = 981 cm/s^2. Taylor–Hood, BDF2/BDF2E, Newton.
 //
-// How to run:   ./ellipse_settling [--h-body 0.004] [--dt 1e-3] [--t-end 1.7] [--output DIR]
+// How to run:   ./ellipse_settling [--h-body 0.004] [--dt 1e-3] [--t-end 1.7] [--curved] [--output DIR]
 //   (`--help` lists every option with its default).
 // What it prints: a progress line every 10 steps; when the centre passes y = 2.0, 1.5, 1.0,
 //   0.6 cm: t, settling speed U = -V_y, the major axis' angle from the horizontal (degrees),
@@ -40,6 +40,7 @@ int main(int argc, char** argv) try {
   Real dt = 1e-3, t_end = 1.7, h_body = 0.004, h_far = 0.03, angle_deg = 45, tolerance = 0;
   std::filesystem::path out = "output/ellipse_settling", restart;
   int vtu_every = 0, checkpoint_every = 100;
+  bool curved = false;
   Options opt("ellipse_settling", "An ellipse settling in a 0.4 x 2.8 cm channel (Xia et al. 2009): it turns broadside.");
   opt.add("dt", dt, "time step (s); with --tolerance > 0 the first one")
       .add("tolerance", tolerance, "local error tolerance of adaptive steps (0: fixed dt)")
@@ -50,17 +51,19 @@ int main(int argc, char** argv) try {
       .add("output", out, "folder for bodies.csv, flow.pvd, checkpoint.bin")
       .add("vtu-every", vtu_every, "VTU output every N steps (0: none)")
       .add("checkpoint-every", checkpoint_every, "checkpoint every N steps (0: none)")
-      .add("restart", restart, "continue from this checkpoint");
+      .add("restart", restart, "continue from this checkpoint")
+      .flag("curved", curved, "isoparametric P2 cells on the ellipse (default: straight cells, a polygon)");
   if (!opt.parse(argc, argv, std::cout)) return 0;
   opt.print(std::cout);
   ALEFSI_CHECK_ARG(std::isfinite(angle_deg), "--angle", "must be finite, got ", angle_deg);
 
   scenes::SettlingEllipse scene;
   scene.ellipse.angle = angle_deg * std::numbers::pi / 180;
+  scene.curved = curved;
   Mesh<2> mesh = restart.empty() ? scene.mesh(h_body, h_far) : read_checkpoint_mesh<2>(restart);
   std::cout << "ellipse " << scene.ellipse.a << " x " << scene.ellipse.b << " cm in a " << scene.width << " x "
-            << scene.height << " cm channel, Taylor-Hood, " << Config::Scheme::name << ": " << mesh.n_nodes()
-            << " nodes, " << mesh.n_cells() << " triangles\n";
+            << scene.height << " cm channel, Taylor-Hood" << (curved ? " (curved cells on the ellipse), " : ", ")
+            << Config::Scheme::name << ": " << mesh.n_nodes() << " nodes, " << mesh.n_cells() << " triangles\n";
   Flow flow(std::move(mesh), {.rho = scene.rho_f, .mu = mu});
   scene.configure(flow, h_body, h_far);
   if (!restart.empty()) {

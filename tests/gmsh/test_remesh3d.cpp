@@ -1,7 +1,8 @@
 // 3D meshing and remeshing by gmsh (alefsi::gmsh): the box-with-spheres mesher (spheres exact,
 // faces tagged, the volume converging at order 2, the same mesh every time), the scenes it
 // refuses, and Remesher3D in the time loop: a settling sphere remeshed as it falls, restarted
-// bit for bit from a checkpoint taken between remeshes; a new mesh below the quality floor
+// bit for bit from a checkpoint taken between remeshes, on straight and on curved cells (the
+// sphere's edge points on it through every remesh); a new mesh below the quality floor
 // refused with the flow left as it was; a spheroid in a spherical container (its caps removed)
 // and its rotation in a linear flow against Jeffery's law.
 #include <catch2/catch.hpp>
@@ -273,9 +274,12 @@ Mesh<3> settling_mesh() {
   return gmsh_box_mesh(settling_box, s, settling_remeshing().size(s));
 }
 
-void configure(SettlingFlow& f, Remesher3D** remesher = nullptr) {
+// curved: isoparametric P2 cells on the sphere (its edge points carried by the rigid map and
+// placed anew on every new mesh)
+void configure(SettlingFlow& f, bool curved, Remesher3D** remesher = nullptr) {
   for (int t : settling_box.tags) f.set_velocity(t, [](const Vec<3>&, Real) { return Vec<3>(0, 0, 0); });
   f.add_body(sphere_body(7, settling_start, settling_a, 2.0));
+  if (curved) f.curve_boundary(7, onto_sphere<3>(settling_start, settling_a));
   f.set_gravity(Vec<3>(0, 0, -10));
   auto r = std::make_unique<Remesher3D>(settling_remeshing());
   if (remesher) *remesher = r.get();
@@ -284,24 +288,33 @@ void configure(SettlingFlow& f, Remesher3D** remesher = nullptr) {
 }  // namespace
 
 TEST_CASE("Remesher3D in the time loop: a settling sphere remeshed as it falls, restarted bit for bit from a "
-          "checkpoint taken between remeshes",
-          "[gmsh][checkpoint][quick]") {
+          "checkpoint taken between remeshes; on straight cells and on curved ones",
+          "[gmsh][checkpoint][curved][quick]") {
+  const bool curved = GENERATE(false, true);
+  CAPTURE(curved);
   const int N = 26;
   const Real dt = 0.05;
   const auto dir = std::filesystem::temp_directory_path() / "alefsi_test_remesh3d";
   std::filesystem::create_directories(dir);
   const auto file = dir / "state.bin";
-  SettlingFlow straight(settling_mesh(), {.rho = 1, .mu = 0.1});
+  SettlingFlow through(settling_mesh(), {.rho = 1, .mu = 0.1});
   Remesher3D* remesher = nullptr;
-  configure(straight, &remesher);
+  configure(through, curved, &remesher);
   int saved_at = -1, since = 0;
+  Real off = 0;  // the sphere's edge points off it, over every step
+  Index n_checked = 0;
   for (int n = 0; n < N; ++n) {
-    since = straight.step(dt).remeshed ? 0 : since + 1;
+    since = through.step(dt).remeshed ? 0 : since + 1;
     // the checkpoint: two steps after the second remesh (before the third)
-    if (saved_at < 0 && straight.stats().remeshes == 2 && since == 2) {
-      straight.save_checkpoint(file);
+    if (saved_at < 0 && through.stats().remeshes == 2 && since == 2) {
+      through.save_checkpoint(file);
       saved_at = n + 1;
     }
+    if (curved)
+      for (Index e : through.mesh().boundary_edges(7)) {
+        off = std::max(off, std::abs((through.geometry()->edge_point(e) - through.body_centre(0)).norm() - settling_a));
+        ++n_checked;
+      }
   }
   const auto& reports = remesher->reports();
   for (const auto& r : reports)
@@ -309,24 +322,32 @@ TEST_CASE("Remesher3D in the time loop: a settling sphere remeshed as it falls, 
               << r.before.worst << " -> " << r.mesher.quality.worst << ", dihedral angles "
               << r.mesher.quality.min_dihedral_deg << " to " << r.mesher.quality.max_dihedral_deg << "\n";
   REQUIRE(saved_at > 0);
-  REQUIRE(straight.stats().remeshes >= 3);  // two before the checkpoint, at least one after
-  // it fell (and sped up) and stayed a sphere: its surface nodes on the sphere at t^n
-  CHECK(straight.body_velocity(0)[2] < -0.3);
-  for (Index v : straight.mesh().boundary_nodes(7))
-    CHECK(std::abs((straight.mesh().node(v) - straight.body_centre(0)).norm() - settling_a) < 1e-12);
+  REQUIRE(through.stats().remeshes >= 3);  // two before the checkpoint, at least one after
+  // it fell (and sped up) and stayed a sphere: its surface nodes on the sphere at t^n, and on
+  // curved cells its edge points on it at every step, through every remesh
+  CHECK(through.body_velocity(0)[2] < -0.3);
+  for (Index v : through.mesh().boundary_nodes(7))
+    CHECK(std::abs((through.mesh().node(v) - through.body_centre(0)).norm() - settling_a) < 1e-12);
+  CHECK((through.geometry() != nullptr) == curved);
+  if (curved) {
+    std::cout << "curved: " << n_checked << " edge points checked, off the sphere by at most " << off << "\n";
+    CHECK(n_checked > 0);
+    CHECK(off < 1e-12);
+  }
 
   SettlingFlow restarted(read_checkpoint_mesh<3>(file), {.rho = 1, .mu = 0.1});
-  configure(restarted);
+  configure(restarted, curved);
   restarted.load_checkpoint(file);
   for (int n = saved_at; n < N; ++n) restarted.step(dt);
-  CHECK(restarted.stats().remeshes == straight.stats().remeshes);
-  CHECK(restarted.time() == straight.time());
-  REQUIRE(restarted.mesh().n_nodes() == straight.mesh().n_nodes());
-  CHECK(restarted.mesh().coordinates() == straight.mesh().coordinates());
-  CHECK(restarted.field() == straight.field());  // bit for bit
-  CHECK(restarted.body_centre(0) == straight.body_centre(0));
-  CHECK(restarted.body_velocity(0) == straight.body_velocity(0));
-  CHECK(restarted.body_orientation(0).coeffs() == straight.body_orientation(0).coeffs());
+  CHECK(restarted.stats().remeshes == through.stats().remeshes);
+  CHECK(restarted.time() == through.time());
+  REQUIRE(restarted.mesh().n_nodes() == through.mesh().n_nodes());
+  CHECK(restarted.mesh().coordinates() == through.mesh().coordinates());
+  CHECK(restarted.field() == through.field());  // bit for bit
+  CHECK(restarted.body_centre(0) == through.body_centre(0));
+  CHECK(restarted.body_velocity(0) == through.body_velocity(0));
+  CHECK(restarted.body_orientation(0).coeffs() == through.body_orientation(0).coeffs());
+  if (curved) CHECK(restarted.geometry()->edge_points() == through.geometry()->edge_points());
   std::filesystem::remove_all(dir);
 }
 
@@ -337,7 +358,7 @@ TEST_CASE("Remesher3D: a new mesh below the quality floor is refused, naming the
   std::filesystem::create_directories(dir);
   const auto file = dir / "state.bin";
   SettlingFlow flow(settling_mesh(), {.rho = 1, .mu = 0.1});
-  configure(flow);
+  configure(flow, false);
   Remesh3DOptions strict = settling_remeshing();
   strict.mesher.quality_floor = 0.9;  // no tetrahedral mesh of this scene reaches it
   strict.enabled = false;             // remeshed below by hand only

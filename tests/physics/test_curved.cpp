@@ -152,7 +152,8 @@ TEST_CASE("quadratic geometry: the annulus' area converges at O(h^4) with edge p
   }
 }
 
-TEST_CASE("onto_ellipsoid: the nearest point, on the surface, along its normal, no farther than any other point",
+TEST_CASE("onto_ellipsoid: the nearest point, on the surface, along its normal, no farther than any other point; "
+          "turned by its axes",
           "[curved][quick]") {
   // a slender triaxial ellipsoid and an ellipse; points outside, just inside (a chord's midpoint)
   // and on the axis inside a tip's circle of curvature
@@ -194,6 +195,22 @@ TEST_CASE("onto_ellipsoid: the nearest point, on the surface, along its normal, 
   CHECK(std::abs((nearest - m).dot(q - p)) < 0.02 * (nearest - m).norm() * (q - p).norm());
   CHECK(std::abs((radial - m).dot((q - p).normalized())) > 0.5 * (radial - m).norm());
   CHECK_THROWS_WITH(onto_ellipsoid<2>(Vec<2>::Zero(), Vec<2>(1, 0)), Catch::Contains("semi_axes"));
+  // a turned ellipsoid (axes the columns of a rotation): the axis-aligned one's nearest point,
+  // turned: on the turned surface, along its normal
+  const Mat<3, 3> A = Eigen::AngleAxis<Real>(0.7, Vec<3>(1, 2, 3).normalized()).toRotationMatrix();
+  const Vec<3> c3(0.3, -0.2, 0.5);
+  const auto turned = onto_ellipsoid<3>(c3, s3, A);
+  const auto aligned = onto_ellipsoid<3>(Vec<3>::Zero(), s3);
+  for (const Vec<3>& x : std::vector<Vec<3>>{{1.3, 0.2, -0.1}, {-0.75, 0.16, 0.2}, {0.2, -0.5, 0.6}}) {
+    const Vec<3> y = turned(Vec<3>(c3 + A * x));
+    CHECK((y - (c3 + A * aligned(x))).norm() < 1e-14);
+    CHECK(std::abs((A.transpose() * (y - c3)).cwiseQuotient(s3).norm() - 1) < 1e-15);
+  }
+  const Real ang = 0.6;
+  const Mat<2, 2> A2 = (Mat<2, 2>() << std::cos(ang), -std::sin(ang), std::sin(ang), std::cos(ang)).finished();
+  const Vec<2> y2 = onto_ellipsoid<2>(Vec<2>::Zero(), s2, A2)(A2 * m);
+  CHECK((y2 - A2 * nearest).norm() < 1e-15);
+  CHECK_THROWS_WITH(onto_ellipsoid<2>(Vec<2>::Zero(), s2, Mat<2, 2>(2 * A2)), Catch::Contains("axes"));
 }
 
 TEST_CASE("quadratic geometry: the shell's volume error drops from O(h^2) to O(h^3) or better", "[curved][quick]") {

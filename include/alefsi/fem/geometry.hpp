@@ -405,4 +405,16 @@ auto onto_ellipsoid(const Vec<D>& centre, const Vec<D>& semi_axes) {
   };
 }
 
+/// The nearest point on a turned ellipsoid (ellipse): the axis-aligned one's (`onto_ellipsoid`)
+/// in the frame whose columns `axes` (orthonormal) are the directions of the semi-axes s:
+/// x -> c + A onto(A^T (x - c)).
+template <int D>
+auto onto_ellipsoid(const Vec<D>& centre, const Vec<D>& semi_axes, const Mat<D, D>& axes) {
+  ALEFSI_CHECK_ARG(axes.allFinite() && (axes.transpose() * axes - Mat<D, D>::Identity()).norm() < 1e-12, "axes",
+                   "must be orthonormal columns");
+  return [centre, axes, onto = onto_ellipsoid<D>(Vec<D>::Zero(), semi_axes)](const Vec<D>& x) -> Vec<D> {
+    return centre + axes * onto(Vec<D>(axes.transpose() * (x - centre)));
+  };
+}
+
 }  // namespace alefsi

@@ -17,6 +17,7 @@
 
 #include "alefsi/core/error.hpp"
 #include "alefsi/core/types.hpp"
+#include "alefsi/fem/geometry.hpp"
 #include "alefsi/mesh/generate/mesher2d.hpp"
 #include "alefsi/physics/collision.hpp"
 #include "alefsi/physics/convex.hpp"
@@ -105,6 +106,7 @@ struct SettlingEllipse {
   Real spring_range = 0.005;   ///< the spring's range (cm)
   Real spring_weights = 50;    ///< the spring's force at contact, in net weights
   bool remeshing = true;
+  bool curved = false;         ///< isoparametric P2 cells on the ellipse (Taylor–Hood only)
 
   void validate() const {
     ALEFSI_CHECK_ARG(width > 0 && height > 0 && std::isfinite(width) && std::isfinite(height), "width, height",
@@ -152,6 +154,16 @@ struct SettlingEllipse {
     flow.set_gravity(gravity, Buoyancy::exact);
     if (collisions) flow.set_collisions(collision_options());
     flow.set_remeshing(remesh_options(h_body, h_far));
+    if (!curved) return;
+    if constexpr (Flow::Space::VelocityElement::degree == 2)
+      flow.curve_boundary(ellipse.tag, projection());
+    else
+      throw InvalidArgument("curved", "isoparametric cells need P2 velocities (Taylor–Hood)");
+  }
+  /// The nearest point on the ellipse at t0: its edge points' projection on curved cells.
+  auto projection() const {
+    const Real c = std::cos(ellipse.angle), s = std::sin(ellipse.angle);
+    return onto_ellipsoid<2>(ellipse.centre, Vec<2>(ellipse.a, ellipse.b), (Mat<2, 2>() << c, -s, s, c).finished());
   }
 
  private:

@@ -14,7 +14,9 @@
 //
 // Levels: the mesh size at the sphere is h_body = D / (4 + 4 level) (level 1: D / 8, 2: D / 12,
 // 3: D / 16), growing by `grading` with the distance to h_far = 8 h_body (at most 10 mm); the
-// time tolerance is 1e-3 / 2^(level - 1) of the velocity scale.
+// time tolerance is 1e-3 / 2^(level - 1) of the velocity scale. --curved: isoparametric P2
+// cells on the sphere (the polyhedron inscribed in it makes the straight runs fall faster than
+// their resolution; near the floor, new cells too coarse for the gap keep straight edges).
 //
 // How to run: ./ten_cate [--case E4] [--level 1] [--t-end 1.5] [--output DIR] [--vtu-every 0]
 //             [--checkpoint-every 0] [--restart] [--no-reuse] [--curved]   (`--help` lists the options)

@@ -206,8 +206,7 @@ TEST_CASE("onto_ellipsoid: the nearest point, on the surface, along its normal, 
     CHECK((y - (c3 + A * aligned(x))).norm() < 1e-14);
     CHECK(std::abs((A.transpose() * (y - c3)).cwiseQuotient(s3).norm() - 1) < 1e-15);
   }
-  const Real ang = 0.6;
-  const Mat<2, 2> A2 = (Mat<2, 2>() << std::cos(ang), -std::sin(ang), std::sin(ang), std::cos(ang)).finished();
+  const Mat<2, 2> A2 = Eigen::Rotation2D<Real>(0.6).toRotationMatrix();
   const Vec<2> y2 = onto_ellipsoid<2>(Vec<2>::Zero(), s2, A2)(A2 * m);
   CHECK((y2 - A2 * nearest).norm() < 1e-15);
   CHECK_THROWS_WITH(onto_ellipsoid<2>(Vec<2>::Zero(), s2, Mat<2, 2>(2 * A2)), Catch::Contains("axes"));

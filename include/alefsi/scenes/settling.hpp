@@ -162,8 +162,8 @@ struct SettlingEllipse {
   }
   /// The nearest point on the ellipse at t0: its edge points' projection on curved cells.
   auto projection() const {
-    const Real c = std::cos(ellipse.angle), s = std::sin(ellipse.angle);
-    return onto_ellipsoid<2>(ellipse.centre, Vec<2>(ellipse.a, ellipse.b), (Mat<2, 2>() << c, -s, s, c).finished());
+    return onto_ellipsoid<2>(ellipse.centre, Vec<2>(ellipse.a, ellipse.b),
+                             Eigen::Rotation2D<Real>(ellipse.angle).toRotationMatrix());
   }
 
  private:

@@ -116,6 +116,22 @@ class QuadraticGeometry {
     for (Index e = 0; e < mesh_->n_edges(); ++e) out[std::size_t(e)] = edge_point(e);
     return out;
   }
+  /// The geometry nodes of facet f: its corners, then the points of its edges (2D the facet
+  /// itself; 3D the edges 01, 12, 20 of its corners): the facet's P2 map, as
+  /// `curved_surface_flux` takes it.
+  std::array<Vec<D>, D*(D + 1) / 2> facet_nodes(Index f) const {
+    const auto& fv = mesh_->facet(f);
+    std::array<Vec<D>, D*(D + 1) / 2> x;
+    for (int a = 0; a < D; ++a) x[std::size_t(a)] = mesh_->node(fv[std::size_t(a)]);
+    for (Index e : mesh_->cell_edges(mesh_->facet_cells(f)[0])) {
+      const auto& ev = mesh_->edge(e);
+      for (int a = 0; a < D * (D - 1) / 2; ++a) {
+        const Index p = fv[std::size_t(a)], q = fv[std::size_t((a + 1) % D)];
+        if ((ev[0] == p && ev[1] == q) || (ev[0] == q && ev[1] == p)) x[std::size_t(D + a)] = edge_point(e);
+      }
+    }
+    return x;
+  }
   /// True when cell c has a displaced edge point (its map is not affine).
   bool curved(Index c) const { return curved_[std::size_t(c)] != 0; }
   /// Number of curved cells.

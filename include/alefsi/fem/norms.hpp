@@ -1,6 +1,7 @@
 #pragma once
 /// \file fem/norms.hpp
-/// Errors of a discrete velocity/pressure field against exact functions.
+/// Errors of a discrete velocity/pressure field against exact functions, and the net flux of a
+/// discrete velocity (`divergence_integral`).
 ///
 /// L2 and H1-seminorm errors of the velocity and the L2 error of the pressure *modulo
 /// constants* (the mean of p_h - p is removed first, so the error does not depend on how the
@@ -80,6 +81,36 @@ FlowErrors flow_errors(const MixedSpace<D, Pair>& space, const VecX& field,
     }
   }
   return {std::sqrt(eu), std::sqrt(eg), std::sqrt(ep)};
+}
+
+/// The integral of div u_h over the domain, through the curved cells' quadratic map if
+/// `geometry` is given: the net flux of u_h out of the domain, which the discrete continuity
+/// equations (their sum: the test function 1) set to zero in a closed domain unless one of
+/// them is left out (a pinned pressure DOF then takes it up as a point source). The rule is of
+/// degree 2k + 2, exact for det J div u_h on a curved cell (degree 3 in 3D).
+template <int D, ElementPair Pair>
+Real divergence_integral(const MixedSpace<D, Pair>& space, const VecX& field,
+                         const QuadraticGeometry<D>* geometry = nullptr) {
+  using V = typename Pair::template Velocity<D>;
+  using Geometry = QuadraticGeometry<D>;
+  const auto& mesh = space.mesh();
+  const auto& rule = simplex_quadrature<D>(2 * V::degree + 2);
+  Real total = 0;
+  for (Index c = 0; c < mesh.n_cells(); ++c) {
+    const bool curved = geometry && geometry->curved(c);
+    const auto X = curved ? geometry->cell_nodes(c) : typename Geometry::Nodes{};
+    Mat<D> J = mesh.jacobian(c);
+    const auto& vd = space.velocity().cell_dofs(c);
+    for (int q = 0; q < rule.size(); ++q) {
+      if (curved) J = Geometry::jacobian(X, Geometry::Shape::gradients(rule.points[q]));
+      const Eigen::Matrix<Real, V::n_dofs, D> G = V::gradients(rule.points[q]) * J.inverse();
+      Real div = 0;
+      for (int a = 0; a < V::n_dofs; ++a)
+        for (int i = 0; i < D; ++i) div += field[space.velocity_field(vd[a], i)] * G(a, i);
+      total += rule.weights[q] * std::abs(J.determinant()) * div;
+    }
+  }
+  return total;
 }
 
 /// Observed convergence rate from two (DOF count, error) pairs: log(e1/e2) / ((1/D) log(N2/N1)).

@@ -39,6 +39,7 @@
 
 #include "alefsi/core/error.hpp"
 #include "alefsi/core/types.hpp"
+#include "alefsi/fem/quadrature.hpp"
 #include "alefsi/mesh/mesh.hpp"
 #include "alefsi/physics/convex.hpp"
 
@@ -291,6 +292,65 @@ Real surface_flux(const std::vector<std::array<Vec<D>, D>>& facets, const F& f, 
     } else {
       for (int i = 0; i < 3; ++i)
         phi += n.dot(velocity_degree == 2 ? f(Vec<3>(0.5 * (x[i] + x[(i + 1) % 3]))) : f(x[i])) / 3;
+    }
+  }
+  return phi;
+}
+
+/// The same flux through a surface of curved facets (isoparametric P2: velocity degree 2 on
+/// cells with quadratic geometry, fem/geometry.hpp). A facet is its D corners, then its edge
+/// points: 2D, an edge's two ends and its point; 3D, a triangle's corners x_0, x_1, x_2 and the
+/// points of its edges 01, 12, 20. The facet is the P2 map of its nodes and the interpolant of
+/// f takes f's values there, so the flux is the integral over the reference facet of
+/// f_h . (dx/ds) rotated (2D) or f_h . (dx/ds_1 x dx/ds_2) (3D): a polynomial of degree 3 (2D)
+/// or 4 (3D), integrated exactly. This is the flux the continuity equations of the curved cells
+/// sum to (the divergence theorem on the mapped cells, which their rule integrates exactly).
+/// With every edge point at its edge's midpoint it is `surface_flux` at degree 2. Oriented as
+/// `surface_flux`: away from the centre, judged on the corners.
+template <int D, class F>
+Real curved_surface_flux(const std::vector<std::array<Vec<D>, D*(D + 1) / 2>>& facets, const F& f) {
+  static_assert(D == 2 || D == 3, "D must be 2 or 3");
+  constexpr int n = D * (D + 1) / 2;  // P2 nodes of a facet
+  const auto& rule = simplex_quadrature<D - 1>(4);
+  Real phi = 0;
+  std::array<Vec<D>, n> fx;
+  for (const auto& x : facets) {
+    Vec<D> straight;  // the corners' normal: only its side of the facet is used
+    if constexpr (D == 2) straight = Vec<2>(x[1][1] - x[0][1], x[0][0] - x[1][0]);
+    else straight = (x[1] - x[0]).cross(x[2] - x[0]);
+    Vec<D> sum = Vec<D>::Zero();
+    for (int i = 0; i < D; ++i) sum += x[std::size_t(i)];
+    const Real side = straight.dot(sum) < 0 ? -1 : 1;
+    for (int a = 0; a < n; ++a) fx[std::size_t(a)] = f(x[std::size_t(a)]);
+    for (int q = 0; q < rule.size(); ++q) {
+      const Vec<D - 1>& s = rule.points[std::size_t(q)];
+      std::array<Real, n> N;
+      std::array<Vec<D - 1>, n> dN;  // d N / d s
+      if constexpr (D == 2) {
+        const Real l0 = 1 - s[0], l1 = s[0];
+        N = {l0 * (2 * l0 - 1), l1 * (2 * l1 - 1), 4 * l0 * l1};
+        dN = {Vec<1>(1 - 4 * l0), Vec<1>(4 * l1 - 1), Vec<1>(4 * (l0 - l1))};
+      } else {
+        const Real l[3] = {1 - s[0] - s[1], s[0], s[1]};
+        const Vec<2> g[3] = {Vec<2>(-1, -1), Vec<2>(1, 0), Vec<2>(0, 1)};  // grad of l_i
+        for (int i = 0; i < 3; ++i) {
+          const int j = (i + 1) % 3;
+          N[std::size_t(i)] = l[i] * (2 * l[i] - 1);
+          dN[std::size_t(i)] = (4 * l[i] - 1) * g[i];
+          N[std::size_t(3 + i)] = 4 * l[i] * l[j];
+          dN[std::size_t(3 + i)] = 4 * (l[i] * g[j] + l[j] * g[i]);
+        }
+      }
+      Vec<D> fh = Vec<D>::Zero();
+      Eigen::Matrix<Real, D, D - 1> T = Eigen::Matrix<Real, D, D - 1>::Zero();  // dx / ds
+      for (int a = 0; a < n; ++a) {
+        fh += N[std::size_t(a)] * fx[std::size_t(a)];
+        T += x[std::size_t(a)] * dN[std::size_t(a)].transpose();
+      }
+      Vec<D> normal;  // |normal| ds = the facet's measure element
+      if constexpr (D == 2) normal = Vec<2>(T(1, 0), -T(0, 0));
+      else normal = Vec<3>(T.col(0)).cross(Vec<3>(T.col(1)));
+      phi += side * rule.weights[std::size_t(q)] * fh.dot(normal);
     }
   }
   return phi;

@@ -622,9 +622,9 @@ class AleFlow {
       body_jacobian_here_.assign(bodies_.size(), 0);
       for (std::size_t k = 0; k < bodies_.size(); ++k) body_jacobian_here_[k] = first[k] == disc_.part();
     }
-    // a closed domain needs each slip discretely flux-free on this mesh (on flat facets: curved
-    // cells carry their slip as given)
-    bodies_.remove_slip_flux(state_.bodies, Space::VelocityElement::degree, disc_.closed_domain() && !geometry_);
+    // a closed domain needs each slip discretely flux-free on this mesh, through its curved
+    // facets if it has them
+    bodies_.remove_slip_flux(state_.bodies, Space::VelocityElement::degree, disc_.closed_domain(), geometry_.get());
     bodies_.check_radii(mesh_, state_.bodies);
     bodies_.check_shapes(state_.bodies);
     if (state_.stats.steps == 0) bodies_.check_slip(mesh_, state_.bodies);

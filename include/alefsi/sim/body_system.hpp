@@ -38,6 +38,7 @@
 #include "alefsi/core/eigen_sparse.hpp"
 #include "alefsi/core/error.hpp"
 #include "alefsi/fem/constraints.hpp"
+#include "alefsi/fem/geometry.hpp"
 #include "alefsi/la/assembler.hpp"
 #include "alefsi/la/coupling.hpp"
 #include "alefsi/mesh/mesh.hpp"
@@ -123,8 +124,12 @@ class BodySystem {
     for (auto& e : entries_) {
       e.nodes = mesh.boundary_nodes(M::tag(e.data));
       e.facets.clear();
+      e.facet_ids.clear();
       for (Index f : mesh.boundary_facets())
-        if (mesh.facet_tag(f) == M::tag(e.data)) e.facets.push_back(mesh.facet(f));
+        if (mesh.facet_tag(f) == M::tag(e.data)) {
+          e.facets.push_back(mesh.facet(f));
+          e.facet_ids.push_back(f);
+        }
     }
   }
 
@@ -286,29 +291,46 @@ class BodySystem {
   /// In a closed domain (`closed`: every boundary velocity given) the discrete continuity
   /// equations sum to "no net flux through the boundary", which the interpolant of a rigid
   /// velocity meets exactly and that of a slip tangent to the exact surface does not: through
-  /// the flat facets it leaks an O(h^2) flux, which a pinned pressure DOF would absorb as a
-  /// point source (and which leaves an unpinned system without a solution). So each body's
-  /// slip is applied less c n, n = r / |r|, c = Phi[u_s] / Phi[n] with Phi the discrete flux
-  /// through its facets on this mesh (surface_flux, in the body frame of its surface offsets):
-  /// the same c while the mesh moves (the surface moves rigidly), recomputed after each remesh.
-  /// Elsewhere c = 0. Call after `attach`, with the surface offsets of `states` on this mesh.
-  void remove_slip_flux(const std::vector<State>& states, int velocity_degree, bool closed) {
+  /// the flat facets it leaks an O(h^2) flux, through curved ones (`geometry`) a smaller one
+  /// that does not vanish either, which a pinned pressure DOF would absorb as a point source
+  /// (and which leaves an unpinned system without a solution). So each body's slip is applied
+  /// less c n, n = r / |r|, c = Phi[u_s] / Phi[n] with Phi the discrete flux through its facets
+  /// on this mesh (surface_flux, or curved_surface_flux through the facets' edge points; in the
+  /// body frame of its surface offsets): the same c while the mesh moves (the surface and its
+  /// edge points move rigidly), recomputed after each remesh. Elsewhere c = 0. Call after
+  /// `attach`, with the surface offsets of `states` on this mesh and its geometry if curved.
+  void remove_slip_flux(const std::vector<State>& states, int velocity_degree, bool closed,
+                        const QuadraticGeometry<D>* geometry = nullptr) {
     for (std::size_t k = 0; k < entries_.size(); ++k) {
       auto& e = entries_[k];
       e.slip_flux = 0;
       if (!closed || !M::has_slip(e.data)) continue;
+      auto radial = [](const Vec<D>& r) { return Vec<D>(r.normalized()); };
+      auto given = [&](const Vec<D>& r) { return Vec<D>(M::slip(e.data, r)); };
+      auto corner = [&](Index v) {
+        const auto j = std::lower_bound(e.nodes.begin(), e.nodes.end(), v) - e.nodes.begin();
+        return states[k].surface[std::size_t(j)];
+      };
+      if (geometry) {
+        ALEFSI_CHECK_ARG(velocity_degree == 2, "velocity_degree", "curved cells carry P2 velocities, got degree ",
+                         velocity_degree);
+        std::vector<std::array<Vec<D>, D*(D + 1) / 2>> facets;
+        facets.reserve(e.facet_ids.size());
+        for (Index f : e.facet_ids) {
+          auto x = geometry->facet_nodes(f);
+          for (auto& p : x) p = M::to_body(p - states[k].centre[0], states[k].orientation[0], e.data);
+          facets.push_back(x);
+        }
+        e.slip_flux = curved_surface_flux<D>(facets, given) / curved_surface_flux<D>(facets, radial);
+        continue;
+      }
       std::vector<std::array<Vec<D>, D>> facets;
       facets.reserve(e.facets.size());
       for (const auto& f : e.facets) {
         std::array<Vec<D>, D> x;
-        for (int i = 0; i < D; ++i) {
-          const auto j = std::lower_bound(e.nodes.begin(), e.nodes.end(), f[i]) - e.nodes.begin();
-          x[i] = states[k].surface[std::size_t(j)];
-        }
+        for (int i = 0; i < D; ++i) x[std::size_t(i)] = corner(f[std::size_t(i)]);
         facets.push_back(x);
       }
-      auto radial = [](const Vec<D>& r) { return Vec<D>(r.normalized()); };
-      auto given = [&](const Vec<D>& r) { return Vec<D>(M::slip(e.data, r)); };
       e.slip_flux = surface_flux<D>(facets, given, velocity_degree) / surface_flux<D>(facets, radial, velocity_degree);
     }
   }
@@ -671,6 +693,7 @@ class BodySystem {
     std::vector<Index> dofs_sorted;                 // the same, sorted (driven bodies)
     std::vector<Index> cells;                       // cells with a surface velocity DOF (driven bodies)
     std::vector<typename Mesh<D>::Facet> facets;    // surface facets
+    std::vector<Index> facet_ids;                   // ... their indices in the mesh
     Real displaced = 0;                             // fluid mass of its exact volume (exact buoyancy), else 0
     Real slip_flux = 0;                             // normal speed removed from the slip (remove_slip_flux)
     // the step's prediction

@@ -336,6 +336,14 @@ TEST_CASE("a body's convex shape must be its meshed surface: turned, too small o
                     Catch::Contains("bodies[0] (tag 5): the shape reaches") && Catch::Contains("too large"));
 }
 
+TEST_CASE("scenes::SettlingEllipse on curved cells needs Taylor-Hood: P1/P1-GLS is refused, naming the parameter",
+          "[scene][quick]") {
+  const scenes::SettlingEllipse scene{.curved = true};
+  AleFlow<FlowConfig<2, P1P1Gls, BDF2_BDF2E>> flow(scene.mesh(0.01, 0.05), {.rho = 1, .mu = 0.01, .tau_dt = 1e-3});
+  CHECK_THROWS_WITH(scene.configure(flow, 0.01, 0.05), Catch::Contains("curved") && Catch::Contains("Taylor"));
+  CHECK(flow.n_bodies() == 0);  // refused before anything was added
+}
+
 TEST_CASE("an ellipse settling in a channel: its first swing is Xia et al.'s (2009)", "[settling][remesh][quick]") {
   // scenes::SettlingEllipse: Xia et al. (2009, J. Fluid Mech. 625, 249), aspect ratio 2,
   // blockage 0.25, density ratio 1.1, released at 45 degrees on the centreline. Released, it

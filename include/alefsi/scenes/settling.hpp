@@ -149,16 +149,15 @@ struct SettlingEllipse {
   template <class Flow>
   void configure(Flow& flow, Real h_body, Real h_far) const {
     validate();
+    if constexpr (Flow::Space::VelocityElement::degree != 2)  // refused before the flow is touched
+      if (curved) throw InvalidArgument("curved", "isoparametric cells need P2 velocities (Taylor–Hood)");
     detail::no_slip_channel(flow);
     flow.add_body(body());
     flow.set_gravity(gravity, Buoyancy::exact);
     if (collisions) flow.set_collisions(collision_options());
     flow.set_remeshing(remesh_options(h_body, h_far));
-    if (!curved) return;
     if constexpr (Flow::Space::VelocityElement::degree == 2)
-      flow.curve_boundary(ellipse.tag, projection());
-    else
-      throw InvalidArgument("curved", "isoparametric cells need P2 velocities (Taylor–Hood)");
+      if (curved) flow.curve_boundary(ellipse.tag, projection());
   }
   /// The nearest point on the ellipse at t0: its edge points' projection on curved cells.
   auto projection() const {

@@ -7,12 +7,14 @@
 
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "alefsi/app/options.hpp"
+#include "alefsi/app/run.hpp"
 #include "alefsi/fem/dofmap.hpp"
 #include "alefsi/mesh/io/gmsh.hpp"
 #include "alefsi/mesh/generate/mesher2d.hpp"
@@ -688,4 +690,15 @@ TEST_CASE("options: numbers, lists, flags and positionals; a bad value names its
   mus = {1, 0.01};
   CHECK_FALSE(make().parse(2, h, &help));
   CHECK_THAT(help.str(), Catch::Contains("--mu") && Catch::Contains("(default 1,0.01)") && Catch::Contains("--newton"));
+}
+
+TEST_CASE("print_run: the run's summary shows dt as it was, whatever the stream's format", "[sim][app][quick]") {
+  RunSummary sum;
+  sum.steps = 2600, sum.dt_smallest = 5e-4, sum.dt_largest = 5e-4, sum.worst_quality = 0.353;
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(4) << 1.0;  // a caller's fixed format, left on the stream
+  app::print_run(out, sum, 1.0, 1.0);
+  // before the fix, setprecision(3) on a fixed stream printed 5e-4 as 0.001
+  CHECK_THAT(out.str(), Catch::Contains("dt 0.0005 to 0.0005") && Catch::Contains("worst quality 0.353"));
+  CHECK((out.flags() & std::ios::floatfield) == std::ios::fixed);  // the caller's format is given back
 }

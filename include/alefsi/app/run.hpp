@@ -47,7 +47,7 @@ void print_remeshes(std::ostream& out, const Reports& reports) {
   const auto flags = out.flags();
   const auto precision = out.precision();
   for (const auto& r : reports)
-    out << "  remesh: " << std::setprecision(3) << r.mesher.seconds
+    out << "  remesh: " << std::defaultfloat << std::setprecision(3) << r.mesher.seconds
         << " s, " << r.mesher.cells << " cells, worst quality " << r.before.worst << " -> " << r.mesher.quality.worst
         << "\n";
   out.flags(flags), out.precision(precision);
@@ -57,7 +57,8 @@ void print_remeshes(std::ostream& out, const Reports& reports) {
 inline void print_run(std::ostream& out, const RunSummary& sum, Real wall_seconds, Real cpu_seconds) {
   const auto flags = out.flags();
   const auto precision = out.precision();
-  out << std::setprecision(3) << "  " << sum.steps << " steps (" << sum.rejected << " rejected, dt " << sum.dt_smallest
+  // (defaultfloat: a caller's std::fixed would print dt = 5e-4 as 0.001)
+  out << std::defaultfloat << std::setprecision(3) << "  " << sum.steps << " steps (" << sum.rejected << " rejected, dt " << sum.dt_smallest
       << " to " << sum.dt_largest << "), " << sum.remeshes << " remeshes, worst quality " << sum.worst_quality
       << std::fixed << std::setprecision(1) << "; wall " << wall_seconds << " s, CPU " << cpu_seconds << " s, peak "
       << std::setprecision(0) << peak_mb() << " MB\n"

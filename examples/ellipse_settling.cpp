@@ -12,6 +12,7 @@
 // viscosity 0.01 g/(cm s); g = 981 cm/s^2. Taylor–Hood, BDF2/BDF2E, Newton.
 //
 // How to run:   ./ellipse_settling [--h-body 0.004] [--dt 1e-3] [--t-end 1.7] [--curved] [--output DIR]
+//               [--semi-minor 0.025]   (0.05: a disk of the same density, settling down the centreline)
 //   (`--help` lists every option with its default).
 // What it prints: a progress line every 10 steps; when the centre passes y = 2.0, 1.5, 1.0,
 //   0.6 cm: t, settling speed U = -V_y, the major axis' angle from the horizontal (degrees),
@@ -37,7 +38,7 @@ using Flow = AleFlow<Config>;
 
 int main(int argc, char** argv) try {
   const Real mu = 0.01;
-  Real dt = 1e-3, t_end = 1.7, h_body = 0.004, h_far = 0.03, angle_deg = 45, tolerance = 0;
+  Real dt = 1e-3, t_end = 1.7, h_body = 0.004, h_far = 0.03, angle_deg = 45, tolerance = 0, semi_minor = 0.025;
   std::filesystem::path out = "output/ellipse_settling", restart;
   int vtu_every = 0, checkpoint_every = 100;
   bool curved = false;
@@ -48,6 +49,7 @@ int main(int argc, char** argv) try {
       .add("h-body", h_body, "mesh size within the ellipse's bounding circle (cm)")
       .add("h-far", h_far, "largest mesh size (cm)")
       .add("angle", angle_deg, "initial angle of the major axis from the horizontal (degrees)")
+      .add("semi-minor", semi_minor, "semi-minor axis b (cm; a = 0.05; b = a: a disk)")
       .add("output", out, "folder for bodies.csv, flow.pvd, checkpoint.bin")
       .add("vtu-every", vtu_every, "VTU output every N steps (0: none)")
       .add("checkpoint-every", checkpoint_every, "checkpoint every N steps (0: none)")
@@ -56,9 +58,11 @@ int main(int argc, char** argv) try {
   if (!opt.parse(argc, argv, std::cout)) return 0;
   opt.print(std::cout);
   ALEFSI_CHECK_ARG(std::isfinite(angle_deg), "--angle", "must be finite, got ", angle_deg);
+  ALEFSI_CHECK_ARG(semi_minor > 0 && semi_minor <= 0.05, "--semi-minor", "must be in (0, a = 0.05], got ", semi_minor);
 
   scenes::SettlingEllipse scene;
   scene.ellipse.angle = angle_deg * std::numbers::pi / 180;
+  scene.ellipse.b = semi_minor;
   scene.curved = curved;
   Mesh<2> mesh = restart.empty() ? scene.mesh(h_body, h_far) : read_checkpoint_mesh<2>(restart);
   std::cout << "ellipse " << scene.ellipse.a << " x " << scene.ellipse.b << " cm in a " << scene.width << " x "

@@ -19,7 +19,8 @@
 // is made of mesh edges, and the slip's jump there is integrated as the smooth even extension
 // of the eastern slip (docs/theory.md). --mesh full meshes the whole cube without symmetry.
 // --curved puts the sphere's edge points on the sphere (isoparametric P2, docs/theory.md 1a):
-// the polyhedron's O(h^2) in V goes, on the same mesh. --slip b1 swaps the paper's slip for
+// the polyhedron's geometric O(h^2) goes; V_x here is limited by the rest of the mesh
+// (docs/results.md). --slip b1 swaps the paper's slip for
 // Blake's smooth first mode with the same exact V (docs/results.md: what limits the accuracy).
 //
 // How to run: ./sphere_squirmer [--h0 0.04] [--growth 0.5] [--half-side 100] [--hmax 50]

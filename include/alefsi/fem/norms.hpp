@@ -99,15 +99,20 @@ Real divergence_integral(const MixedSpace<D, Pair>& space, const VecX& field,
   for (Index c = 0; c < mesh.n_cells(); ++c) {
     const bool curved = geometry && geometry->curved(c);
     const auto X = curved ? geometry->cell_nodes(c) : typename Geometry::Nodes{};
-    Mat<D> J = mesh.jacobian(c);
+    Mat<D> J = mesh.jacobian(c), Jinv = J.inverse();  // constant on an affine cell
+    Real detJ = std::abs(J.determinant());
     const auto& vd = space.velocity().cell_dofs(c);
     for (int q = 0; q < rule.size(); ++q) {
-      if (curved) J = Geometry::jacobian(X, Geometry::Shape::gradients(rule.points[q]));
-      const Eigen::Matrix<Real, V::n_dofs, D> G = V::gradients(rule.points[q]) * J.inverse();
+      if (curved) {
+        J = Geometry::jacobian(X, Geometry::Shape::gradients(rule.points[q]));
+        Jinv = J.inverse();
+        detJ = std::abs(J.determinant());
+      }
+      const Eigen::Matrix<Real, V::n_dofs, D> G = V::gradients(rule.points[q]) * Jinv;
       Real div = 0;
       for (int a = 0; a < V::n_dofs; ++a)
         for (int i = 0; i < D; ++i) div += field[space.velocity_field(vd[a], i)] * G(a, i);
-      total += rule.weights[q] * std::abs(J.determinant()) * div;
+      total += rule.weights[q] * detJ * div;
     }
   }
   return total;

@@ -15,6 +15,12 @@
 //          --colamd-max N   (default 128) largest N for COLAMD (N = 256 takes minutes)
 //          --pivot-threshold T   SparseLU's diagonal pivot threshold for the symmetric
 //                   orderings (saddle, amd; default SparseLu's, 1e-6)
+//          --precision M   instead of the table: SparseLU (saddle-point AMD) factors in double
+//                   and in single precision as GMRES preconditioners (factorisation reuse,
+//                   la/linear_solve.hpp), on the flow matrices with a mass term M times the
+//                   velocity diagonal added (the rho / dt of a time step; 0: steady Stokes)
+//
+//   OPENBLAS_NUM_THREADS=1 build/bench/bench/bench_solvers --pairs P1P1GLS --sizes 144 --precision 5
 //
 // One line per (problem, N, solver), markdown table: unknowns, nnz, analyse / factorise /
 // solve CPU seconds (process CPU time, so BLAS threads count; minimum over the repeats),
@@ -41,6 +47,7 @@
 #include "alefsi/fem/constraints.hpp"
 #include "alefsi/fem/dofmap.hpp"
 #include "alefsi/la/assembler.hpp"
+#include "alefsi/la/gmres.hpp"
 #include "alefsi/la/ordering.hpp"
 #include "alefsi/la/solvers.hpp"
 #include "alefsi/la/suitesparse.hpp"
@@ -154,6 +161,87 @@ Real relative_residual(const SparseMatrix& A, const VecX& x, const VecX& b) {
   return std::sqrt(rr / bb);
 }
 
+// The velocity diagonal of a flow system times 1 + mass: a time step's mass term rho / dt
+// (lumped), `mass` times the viscous diagonal.
+template <class Pair>
+void add_mass(LinearSystem& s, int n, double mass) {
+  const Mesh<2> mesh = rectangle_mesh(n, n);
+  MixedSpace<2, Pair> space(mesh);
+  VecX velocity = VecX::Zero(space.n_field());
+  for (Index i = 0; i < space.velocity().n_dofs(); ++i)
+    for (int k = 0; k < 2; ++k) velocity[space.velocity_field(i, k)] = 1;
+  // the same constraints as stokes_system: every boundary velocity and pressure 0
+  DofConstraints cons(space.n_field());
+  std::vector<char> done(space.velocity().n_dofs(), 0);
+  for (int t = 1; t <= 4; ++t)
+    for (Index i : space.velocity().boundary_dofs(t))
+      if (!done[i]) {
+        done[i] = 1;
+        for (int k = 0; k < 2; ++k) cons.fix(space.velocity_field(i, k), 0.0);
+      }
+  cons.fix(space.pressure_field(0), 0.0);
+  cons.finalize();
+  const VecX free = cons.restrict_free(velocity);
+  for (Index i = 0; i < s.A.rows(); ++i)
+    if (free[i] == 1) s.A.coeffRef(i, i) *= 1 + mass;
+}
+
+// Factors in double and in single precision as right preconditioners of GMRES to 1e-13 (the
+// factorisation reuse's tolerance): on the factorised matrix itself and on one whose entries
+// are perturbed by a relative 1e-3 (a later matrix of the same pattern). Prints the times and
+// the iterations.
+template <class Pair>
+void precision_study(const std::string& pair, int n, double mass, int repeat) {
+  LinearSystem s = stokes_system<Pair>(n);
+  add_mass<Pair>(s, n, mass);
+  SparseMatrix later = s.A;
+  unsigned state = 12345;  // a fixed sequence: the same perturbation every run
+  for (Index k = 0; k < later.nonZeros(); ++k) {
+    state = state * 1664525u + 1013904223u;
+    later.valuePtr()[k] *= 1 + 1e-3 * (double(state) / 4294967296.0 * 2 - 1);
+  }
+  using SpF = Eigen::SparseMatrix<float, Eigen::ColMajor, Index>;
+  Eigen::SparseLU<SparseMatrix, SaddlePointAmdOrdering<Index>> lu;
+  Eigen::SparseLU<SpF, SaddlePointAmdOrdering<Index>> luf;
+  lu.isSymmetric(true), luf.isSymmetric(true);
+  lu.setPivotThreshold(SparseLu<>::default_pivot_threshold), luf.setPivotThreshold(float(SparseLu<>::default_pivot_threshold));
+  const SpF Af = s.A.cast<float>();
+  lu.analyzePattern(s.A), luf.analyzePattern(Af);
+  double fd = 1e300, ff = 1e300, sd = 1e300, sf = 1e300;
+  VecX x;
+  Eigen::VectorXf xf;
+  const Eigen::VectorXf bf = s.b.cast<float>();
+  for (int r = 0; r < repeat; ++r) {
+    double c0 = cpu_seconds();
+    lu.factorize(s.A);
+    double c1 = cpu_seconds();
+    luf.factorize(Af);
+    double c2 = cpu_seconds();
+    fd = std::min(fd, c1 - c0), ff = std::min(ff, c2 - c1);
+    c0 = cpu_seconds();
+    for (int k = 0; k < 10; ++k) x = lu.solve(s.b);
+    c1 = cpu_seconds();
+    for (int k = 0; k < 10; ++k) xf = luf.solve(bf);
+    c2 = cpu_seconds();
+    sd = std::min(sd, (c1 - c0) / 10), sf = std::min(sf, (c2 - c1) / 10);
+  }
+  if (lu.info() != Eigen::Success || luf.info() != Eigen::Success) {
+    std::printf("| %s | %d | factorisation failed |\n", pair.c_str(), n);
+    return;
+  }
+  GmresWork work;
+  auto its = [&](const SparseMatrix& M, auto&& precondition) {
+    return gmres(M, s.b, precondition, {.tolerance = 1e-13, .max_iterations = 200, .restart = 200}, x, work).iterations;
+  };
+  auto pd = [&](const VecX& v) { return VecX(lu.solve(v)); };
+  auto pf = [&](const VecX& v) { return VecX(luf.solve(v.cast<float>()).cast<double>()); };
+  std::printf("| %s | %d | %d | %g | %.3f / %.3f | %.4f / %.4f | %.1e / %.1e | %d / %d | %d / %d |\n", pair.c_str(), n,
+              int(s.A.rows()), mass, fd, ff, sd, sf, relative_residual(s.A, lu.solve(s.b), s.b),
+              relative_residual(s.A, luf.solve(bf).cast<double>(), s.b), its(s.A, pd), its(s.A, pf), its(later, pd),
+              its(later, pf));
+  std::fflush(stdout);
+}
+
 // ---- one solver on one system ----------------------------------------------------------------
 struct Result {
   double analyse = 1e300, factorise = 1e300, solve = 1e300, factorise_wall = 1e300;
@@ -191,6 +279,7 @@ struct Options {
   int repeat = 3;
   int colamd_max = 128;
   double pivot_threshold = -1;  // < 0: SparseLu's default
+  double precision_mass = -1;   // >= 0: the precision study with this mass term
 };
 
 bool wanted(const Options& o, const std::string& s) {
@@ -283,6 +372,8 @@ int main(int argc, char** argv) {
       o.colamd_max = std::stoi(val);
     } else if (key == "--pivot-threshold") {
       o.pivot_threshold = std::stod(val);
+    } else if (key == "--precision") {
+      o.precision_mass = std::stod(val);
     } else {
       std::fprintf(stderr, "unknown option %s (see the comment at the top of bench/bench_solvers.cpp)\n", key.c_str());
       return 2;
@@ -302,6 +393,17 @@ int main(int argc, char** argv) {
               "no"
 #endif
   );
+  if (o.precision_mass >= 0) {
+    std::printf("| problem | N | unknowns | mass | factorise s, double / single | solve s, double / single | "
+                "rel. residual, double / single | GMRES its to 1e-13, same matrix, double / single | "
+                "later matrix, double / single |\n|---|---|---|---|---|---|---|---|---|\n");
+    for (const auto& pair : o.pairs)
+      for (int n : o.sizes) {
+        if (pair == "P2P1") precision_study<TaylorHood>(pair, n, o.precision_mass, o.repeat);
+        else if (pair == "P1P1GLS") precision_study<P1P1Gls>(pair, n, o.precision_mass, o.repeat);
+      }
+    return 0;
+  }
   std::printf("| problem | N | unknowns | nnz | solver | analyse s | factorise s | factorise wall s | solve s | "
               "nnz(L+U) | fill | peak MB | base MB | rel. residual |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");

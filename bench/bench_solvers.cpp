@@ -89,9 +89,11 @@ struct LinearSystem {
   VecX b;
 };
 
-// Driven cavity: every boundary velocity fixed (lid (1, 0)), pressure DOF 0 pinned, mu = 1.
+// Driven cavity: every boundary velocity fixed (lid (1, 0)), pressure DOF 0 pinned, mu = 1;
+// with `mass` > 0 the velocity diagonal times 1 + mass (a time step's lumped rho / dt, `mass`
+// times the viscous diagonal).
 template <class Pair>
-LinearSystem stokes_system(int n) {
+LinearSystem stokes_system(int n, double mass = 0) {
   const Mesh<2> mesh = rectangle_mesh(n, n);
   MixedSpace<2, Pair> space(mesh);
   StokesKernel<2, Pair> kernel(space, 1.0);
@@ -115,6 +117,14 @@ LinearSystem stokes_system(int n) {
   VecX r;
   asmb.assemble(kernel, cons.expand(VecX::Zero(cons.n_unknowns())), &s.A, &r);
   s.b = -r;
+  if (mass > 0) {
+    VecX velocity = VecX::Zero(space.n_field());
+    for (Index i = 0; i < vel.n_dofs(); ++i)
+      for (int k = 0; k < 2; ++k) velocity[space.velocity_field(i, k)] = 1;
+    const VecX free = cons.restrict_free(velocity);
+    for (Index i = 0; i < s.A.rows(); ++i)
+      if (free[i] == 1) s.A.coeffRef(i, i) *= 1 + mass;
+  }
   return s;
 }
 
@@ -161,39 +171,13 @@ Real relative_residual(const SparseMatrix& A, const VecX& x, const VecX& b) {
   return std::sqrt(rr / bb);
 }
 
-// The velocity diagonal of a flow system times 1 + mass: a time step's mass term rho / dt
-// (lumped), `mass` times the viscous diagonal.
-template <class Pair>
-void add_mass(LinearSystem& s, int n, double mass) {
-  const Mesh<2> mesh = rectangle_mesh(n, n);
-  MixedSpace<2, Pair> space(mesh);
-  VecX velocity = VecX::Zero(space.n_field());
-  for (Index i = 0; i < space.velocity().n_dofs(); ++i)
-    for (int k = 0; k < 2; ++k) velocity[space.velocity_field(i, k)] = 1;
-  // the same constraints as stokes_system: every boundary velocity and pressure 0
-  DofConstraints cons(space.n_field());
-  std::vector<char> done(space.velocity().n_dofs(), 0);
-  for (int t = 1; t <= 4; ++t)
-    for (Index i : space.velocity().boundary_dofs(t))
-      if (!done[i]) {
-        done[i] = 1;
-        for (int k = 0; k < 2; ++k) cons.fix(space.velocity_field(i, k), 0.0);
-      }
-  cons.fix(space.pressure_field(0), 0.0);
-  cons.finalize();
-  const VecX free = cons.restrict_free(velocity);
-  for (Index i = 0; i < s.A.rows(); ++i)
-    if (free[i] == 1) s.A.coeffRef(i, i) *= 1 + mass;
-}
-
 // Factors in double and in single precision as right preconditioners of GMRES to 1e-13 (the
 // factorisation reuse's tolerance): on the factorised matrix itself and on one whose entries
 // are perturbed by a relative 1e-3 (a later matrix of the same pattern). Prints the times and
 // the iterations.
 template <class Pair>
 void precision_study(const std::string& pair, int n, double mass, int repeat) {
-  LinearSystem s = stokes_system<Pair>(n);
-  add_mass<Pair>(s, n, mass);
+  const LinearSystem s = stokes_system<Pair>(n, mass);
   SparseMatrix later = s.A;
   unsigned state = 12345;  // a fixed sequence: the same perturbation every run
   for (Index k = 0; k < later.nonZeros(); ++k) {

@@ -55,7 +55,8 @@ int main(int argc, char** argv) try {
                                            .g = 1,
                                            .h_body = h_body,
                                            .h_far = std::min(8 * h_body, 0.75),
-                                           .grading = 0.25};
+                                           .grading = 0.25,
+                                           .velocities = {Vec<3>(0, 0, -0.38), Vec<3>(0, 0, -0.45)}};
   scene.validate();
   const Mesh<3> mesh = gmsh_box_mesh(box, scene.spheres, scene.size_rule()(scene.spheres));
   std::cout << "level " << level << " (h_body = d / " << 8 * level << "): " << mesh.n_cells() << " tetrahedra; gap "
@@ -66,15 +67,10 @@ int main(int argc, char** argv) try {
   std::vector<std::vector<Vec<6>>> velocities(2);
   for (bool coupled : {true, false}) {
     Flow flow(mesh, scene.flow_options());
-    for (int t : box.tags) flow.set_velocity(t, [](const Vec<3>&, Real) { return Vec<3>(0, 0, 0); });
-    auto b0 = sphere_body(7, lead, 0.5, scene.rho_p), b1 = sphere_body(8, trail, 0.5, scene.rho_p);
-    b0.velocity << 0, 0, -0.38, 0, 0, 0;
-    b1.velocity << 0, 0, -0.45, 0, 0, 0;
-    flow.add_body(b0);
-    flow.add_body(b1);
-    flow.set_gravity(Vec<3>(0, 0, -scene.g), Buoyancy::exact);
-    if (coupled) flow.set_collisions(scene.collisions());
-    else flow.set_contact_model(std::make_unique<LaggedPairCoupling<3>>(DefaultContact<3>::collisions(scene.collisions())));
+    scene.configure(flow);  // the pair coupled in the Newton matrix
+    if (!coupled)
+      flow.set_contact_model(
+          std::make_unique<LaggedPairCoupling<3>>(DefaultContact<3>::collisions(scene.collisions())));
     std::cout << (coupled ? "coupled" : "lagged") << ":\n";
     const auto wall0 = std::chrono::steady_clock::now();
     const Real cpu0 = app::cpu_seconds();

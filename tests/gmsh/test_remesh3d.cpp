@@ -477,7 +477,8 @@ TEST_CASE("Newton in contact, 3D, on SaddlePointGmres: with the pair coupling in
                                            .g = 1,
                                            .h_body = 0.25,
                                            .h_far = 0.6,
-                                           .grading = 0.3};
+                                           .grading = 0.3,
+                                           .velocities = {Vec<3>(0, 0, -0.38), Vec<3>(0, 0, -0.45)}};
   scene.validate();
   const Mesh<3> mesh = gmsh_box_mesh(scene.box, scene.spheres, scene.size_rule()(scene.spheres));
   const std::vector<Real> dts = {0.01, 0.03, 0.1, 0.3, 0.3};
@@ -487,15 +488,8 @@ TEST_CASE("Newton in contact, 3D, on SaddlePointGmres: with the pair coupling in
     fo.newton_tolerance = 1e-10;
     fo.max_newton = 100;  // the lagged iteration's count is measured, not capped
     Flow flow(mesh, fo);
-    for (int t : scene.box.tags) flow.set_velocity(t, [](const Vec<3>&, Real) { return Vec<3>(0, 0, 0); });
-    RigidBody3D b0 = sphere_body(7, lead, 0.5, scene.rho_p), b1 = sphere_body(8, trail, 0.5, scene.rho_p);
-    b0.velocity << 0, 0, -0.38, 0, 0, 0;
-    b1.velocity << 0, 0, -0.45, 0, 0, 0;
-    flow.add_body(b0);
-    flow.add_body(b1);
-    flow.set_gravity(Vec<3>(0, 0, -scene.g), Buoyancy::exact);
-    if (coupled) flow.set_collisions(scene.collisions());
-    else
+    scene.configure(flow);  // the pair coupled in the Newton matrix
+    if (!coupled)
       flow.set_contact_model(
           std::make_unique<LaggedPairCoupling<3>>(DefaultContact<3>::collisions(scene.collisions())));
     for (Real dt : dts) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -545,6 +546,9 @@ TEST_CASE("scenes::SpheresSettlingInBox: bad parameters are refused by name; its
   t = s, t.spheres.clear(), refused(t, "spheres");
   t = s, t.spheres[1].centre = Vec<3>(0, 0, 2.3), refused(t, "bodies[");  // overlapping the first
   t = s, t.spheres[0].centre = Vec<3>(0, 0, 2.9), refused(t, "bodies[0]");  // through the lid
+  t = s, t.velocities = {Vec<3>(0, 0, -1)}, refused(t, "velocities");        // one for two spheres
+  const Real nan = std::numeric_limits<Real>::quiet_NaN();
+  t = s, t.velocities = {Vec<3>(0, 0, -1), Vec<3>(0, nan, 0)}, refused(t, "velocities[1]");
   // eq. (24) on the approach speed, the spring of range h_body / 2 carrying 4 buoyant weights of
   // the smaller sphere
   const CollisionOptions c = s.collisions();

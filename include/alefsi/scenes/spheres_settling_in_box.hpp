@@ -5,7 +5,8 @@
 /// (examples/dkt3d.cpp). It holds the physical data and the mesh sizes, checks them, gives the
 /// size function of the mesher and the remesher, and configures a flow:
 ///   - no-slip walls on the box's six faces;
-///   - the spheres as free bodies (`sphere_body`, density rho_p);
+///   - the spheres as free bodies (`sphere_body`, density rho_p), at rest or moving at
+///     `velocities`;
 ///   - gravity along -z with the spheres' exact buoyancy (`Buoyancy::exact`: with rho_p / rho_f
 ///     near 1 the volume error of the polyhedral holes would enter the net weight
 ///     rho_f / (rho_p - rho_f) times over);
@@ -48,6 +49,7 @@ struct SpheresSettlingInBox {
   Real g = 1;                   ///< gravity's magnitude, along -z
   Real h_body = 0.1, h_far = 1, grading = 0.25;  ///< mesh sizes: graded_size(spheres, h_body, h_far, grading)
   Real spring_weights = 4;  ///< the spring's force at contact, in buoyant weights of the smallest sphere
+  std::vector<Vec<3>> velocities{};  ///< the spheres' velocities at t = 0, one per sphere (empty: at rest)
 
   void validate() const {
     box.validate();
@@ -63,6 +65,10 @@ struct SpheresSettlingInBox {
     ALEFSI_CHECK_ARG(grading > 0 && std::isfinite(grading), "grading", "must be positive and finite, got ", grading);
     ALEFSI_CHECK_ARG(spring_weights > 1 && std::isfinite(spring_weights), "spring_weights",
                      "must exceed 1 (the spring must carry a sphere) and be finite, got ", spring_weights);
+    ALEFSI_CHECK_ARG(velocities.empty() || velocities.size() == spheres.size(), "velocities",
+                     "must be empty (at rest) or hold one per sphere (", spheres.size(), "), got ", velocities.size());
+    for (std::size_t k = 0; k < velocities.size(); ++k)
+      ALEFSI_CHECK_ARG(velocities[k].allFinite(), "velocities[" + std::to_string(k) + "]", "must be finite");
   }
 
   FlowOptions flow_options() const { return {.rho = rho_f, .mu = mu}; }
@@ -90,12 +96,17 @@ struct SpheresSettlingInBox {
             .law = CollisionLaw::lubrication};
   }
 
-  /// No-slip walls, the free spheres, gravity with exact buoyancy, the contacts.
+  /// No-slip walls, the free spheres (moving at `velocities`, if given), gravity with exact
+  /// buoyancy, the contacts.
   template <class Flow>
   void configure(Flow& flow) const {
     validate();
     for (int t : box.tags) flow.set_velocity(t, [](const Vec<3>&, Real) { return Vec<3>(0, 0, 0); });
-    for (const Sphere& s : spheres) flow.add_body(sphere_body(s.tag, s.centre, s.radius, rho_p));
+    for (std::size_t k = 0; k < spheres.size(); ++k) {
+      auto body = sphere_body(spheres[k].tag, spheres[k].centre, spheres[k].radius, rho_p);
+      if (!velocities.empty()) body.velocity.template head<3>() = velocities[k];
+      flow.add_body(body);
+    }
     flow.set_gravity(Vec<3>(0, 0, -g), Buoyancy::exact);
     flow.set_collisions(collisions());
   }

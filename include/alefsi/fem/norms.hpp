@@ -25,6 +25,32 @@ struct FlowErrors {
   Real u_l2 = 0, u_h1 = 0, p_l2 = 0;
 };
 
+namespace detail {
+/// Calls f(q, x, Jinv, detJ) at each point q of `rule` in cell c: the physical point, the
+/// inverse Jacobian and |det J|, of the affine map (J^-1 and det J once for the cell) or, on a
+/// curved cell of `geometry`, of its quadratic map at that point.
+template <int D, class F>
+void for_each_point(const Mesh<D>& mesh, const QuadraticGeometry<D>* geometry, const QuadratureRule<D>& rule,
+                    Index c, F&& f) {
+  using Geometry = QuadraticGeometry<D>;
+  const bool curved = geometry && geometry->curved(c);
+  const auto X = curved ? geometry->cell_nodes(c) : typename Geometry::Nodes{};
+  Mat<D> J = mesh.jacobian(c), Jinv = J.inverse();
+  Real detJ = std::abs(J.determinant());
+  const Vec<D> x0 = mesh.node(mesh.cell(c)[0]);
+  for (int q = 0; q < rule.size(); ++q) {
+    Vec<D> x = x0 + J * rule.points[q];
+    if (curved) {
+      J = Geometry::jacobian(X, Geometry::Shape::gradients(rule.points[q]));
+      Jinv = J.inverse();
+      detJ = std::abs(J.determinant());
+      x = Geometry::map(X, Geometry::Shape::values(rule.points[q]));
+    }
+    f(q, static_cast<const Vec<D>&>(x), static_cast<const Mat<D>&>(Jinv), detJ);
+  }
+}
+}  // namespace detail
+
 template <int D, ElementPair Pair>
 FlowErrors flow_errors(const MixedSpace<D, Pair>& space, const VecX& field,
                        const std::function<Vec<D>(const Vec<D>&)>& u,
@@ -33,27 +59,14 @@ FlowErrors flow_errors(const MixedSpace<D, Pair>& space, const VecX& field,
                        const QuadraticGeometry<D>* geometry = nullptr) {
   using V = typename Pair::template Velocity<D>;
   using P = typename Pair::template Pressure<D>;
-  using Geometry = QuadraticGeometry<D>;
   const auto& mesh = space.mesh();
   const auto& rule = simplex_quadrature<D>(2 * V::degree + 4);
   Real eu = 0, eg = 0, ep = 0, ep_mean = 0, vol = 0;
   for (int pass = 0; pass < 2; ++pass) {
     for (Index c = 0; c < mesh.n_cells(); ++c) {
-      const bool curved = geometry && geometry->curved(c);
-      const auto X = curved ? geometry->cell_nodes(c) : typename Geometry::Nodes{};
-      Mat<D> J = mesh.jacobian(c), Jinv = J.inverse();
-      Real detJ = std::abs(J.determinant());
-      const Vec<D> x0 = mesh.node(mesh.cell(c)[0]);
       const auto& vd = space.velocity().cell_dofs(c);
       const auto& pd = space.pressure().cell_dofs(c);
-      for (int q = 0; q < rule.size(); ++q) {
-        Vec<D> x = x0 + J * rule.points[q];
-        if (curved) {
-          J = Geometry::jacobian(X, Geometry::Shape::gradients(rule.points[q]));
-          Jinv = J.inverse();
-          detJ = std::abs(J.determinant());
-          x = Geometry::map(X, Geometry::Shape::values(rule.points[q]));
-        }
+      detail::for_each_point(mesh, geometry, rule, c, [&](int q, const Vec<D>& x, const Mat<D>& Jinv, Real detJ) {
         const Real w = rule.weights[q] * detJ;
         const auto php = P::values(rule.points[q]);
         Real ph = 0;
@@ -77,7 +90,7 @@ FlowErrors flow_errors(const MixedSpace<D, Pair>& space, const VecX& field,
         } else {
           ep += w * std::pow(dp - ep_mean / vol, 2);
         }
-      }
+      });
     }
   }
   return {std::sqrt(eu), std::sqrt(eg), std::sqrt(ep)};
@@ -92,28 +105,18 @@ template <int D, ElementPair Pair>
 Real divergence_integral(const MixedSpace<D, Pair>& space, const VecX& field,
                          const QuadraticGeometry<D>* geometry = nullptr) {
   using V = typename Pair::template Velocity<D>;
-  using Geometry = QuadraticGeometry<D>;
   const auto& mesh = space.mesh();
   const auto& rule = simplex_quadrature<D>(2 * V::degree + 2);
   Real total = 0;
   for (Index c = 0; c < mesh.n_cells(); ++c) {
-    const bool curved = geometry && geometry->curved(c);
-    const auto X = curved ? geometry->cell_nodes(c) : typename Geometry::Nodes{};
-    Mat<D> J = mesh.jacobian(c), Jinv = J.inverse();  // constant on an affine cell
-    Real detJ = std::abs(J.determinant());
     const auto& vd = space.velocity().cell_dofs(c);
-    for (int q = 0; q < rule.size(); ++q) {
-      if (curved) {
-        J = Geometry::jacobian(X, Geometry::Shape::gradients(rule.points[q]));
-        Jinv = J.inverse();
-        detJ = std::abs(J.determinant());
-      }
+    detail::for_each_point(mesh, geometry, rule, c, [&](int q, const Vec<D>&, const Mat<D>& Jinv, Real detJ) {
       const Eigen::Matrix<Real, V::n_dofs, D> G = V::gradients(rule.points[q]) * Jinv;
       Real div = 0;
       for (int a = 0; a < V::n_dofs; ++a)
         for (int i = 0; i < D; ++i) div += field[space.velocity_field(vd[a], i)] * G(a, i);
       total += rule.weights[q] * detJ * div;
-    }
+    });
   }
   return total;
 }

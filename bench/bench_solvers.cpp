@@ -17,7 +17,7 @@
 //                   orderings (saddle, amd; default SparseLu's, 1e-6)
 //          --precision M   instead of the table: SparseLU (saddle-point AMD) factors in double
 //                   and in single precision as GMRES preconditioners (factorisation reuse,
-//                   la/linear_solve.hpp), by la/gmres.hpp and by a flexible GMRES, on the
+//                   la/linear_solve.hpp), by la/gmres.hpp, plain and flexible (FGMRES), on the
 //                   flow matrices (P2P1, P1P1GLS; MESH is skipped) with a mass term M times
 //                   the velocity diagonal added (the rho / dt of a time step; 0: steady Stokes)
 //
@@ -173,51 +173,8 @@ Real relative_residual(const SparseMatrix& A, const VecX& x, const VecX& b) {
   return std::sqrt(rr / bb);
 }
 
-// Flexible GMRES (Saad 1993; Saad, Iterative Methods for Sparse Linear Systems, 2nd ed.,
-// Algorithm 9.6) from x = 0, one cycle of at most `max_iterations`: it keeps z_k = P^-1 v_k and
-// forms x = Z y, where la/gmres.hpp forms x = P^-1 (V y) and so needs P^-1 to be linear to
-// rounding. A measurement for precision_study, not the library's solver. Returns the
-// applications of P^-1 (0 when the tolerance was not met).
-template <class Precondition>
-int flexible_gmres_applications(const SparseMatrix& A, const VecX& b, Precondition&& precondition, Real tolerance,
-                                int max_iterations) {
-  const Index n = b.size();
-  const int m = max_iterations;
-  MatX V(n, m + 1), Z(n, m), H = MatX::Zero(m + 1, m);
-  VecX g = VecX::Zero(m + 1), cs(m), sn(m);
-  const Real bnorm = b.norm();
-  V.col(0) = b / bnorm;
-  g[0] = bnorm;
-  int k = 0;
-  while (k < m && !(std::abs(g[k]) <= tolerance * bnorm)) {
-    Z.col(k) = precondition(VecX(V.col(k)));
-    VecX w = A * Z.col(k);
-    for (int i = 0; i <= k; ++i) {
-      H(i, k) = w.dot(V.col(i));
-      w -= H(i, k) * V.col(i);
-    }
-    H(k + 1, k) = w.norm();
-    if (H(k + 1, k) > 0) V.col(k + 1) = w / H(k + 1, k);
-    for (int i = 0; i < k; ++i) {
-      const Real t = cs[i] * H(i, k) + sn[i] * H(i + 1, k);
-      H(i + 1, k) = -sn[i] * H(i, k) + cs[i] * H(i + 1, k);
-      H(i, k) = t;
-    }
-    const Real h = std::hypot(H(k, k), H(k + 1, k));
-    cs[k] = H(k, k) / h, sn[k] = H(k + 1, k) / h;
-    H(k, k) = h, H(k + 1, k) = 0;
-    g[k + 1] = -sn[k] * g[k];
-    g[k] = cs[k] * g[k];
-    ++k;
-  }
-  const VecX y = H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
-  const VecX x = Z.leftCols(k) * y;
-  return relative_residual(A, x, b) <= 10 * tolerance ? k : 0;
-}
-
 // Factors in double and in single precision as right preconditioners to 1e-13 (the
-// factorisation reuse's tolerance), by the library's GMRES (la/gmres.hpp) and by flexible
-// GMRES: on the factorised matrix itself and on a later matrix of the same pattern, each entry
+// factorisation reuse's tolerance), by la/gmres.hpp's GMRES, plain and flexible: on the factorised matrix itself and on a later matrix of the same pattern, each entry
 // moved by an independent random relative amount in [-1e-3, 1e-3]. Prints the times and the
 // applications of P^-1 (a GMRES cycle applies it once more than its iterations).
 template <class Pair>
@@ -266,12 +223,8 @@ void precision_study(const std::string& pair, int n, double mass, int repeat, do
   // "n/c": the tolerance not met in 200
   auto count = [&](const SparseMatrix& M, auto& precondition, bool flexible) {
     applications = 0;
-    bool ok = true;
-    if (flexible)
-      ok = flexible_gmres_applications(M, s.b, precondition, 1e-13, 200) > 0;
-    else
-      ok = gmres(M, s.b, precondition, {.tolerance = 1e-13, .max_iterations = 200, .restart = 200}, x, work).converged;
-    return ok ? std::to_string(applications) : std::string("n/c");
+    const GmresOptions opt{.tolerance = 1e-13, .max_iterations = 200, .restart = 200, .flexible = flexible};
+    return gmres(M, s.b, precondition, opt, x, work).converged ? std::to_string(applications) : std::string("n/c");
   };
   std::string cols;
   for (const SparseMatrix* M : std::array<const SparseMatrix*, 2>{&s.A, &later})

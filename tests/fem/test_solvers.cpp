@@ -730,6 +730,84 @@ TEST_CASE("gmres with augment (LGMRES): the corrections keep what a short restar
   CHECK(x0 == x1);
 }
 
+TEST_CASE("gmres with flexible (FGMRES): the iterate of plain GMRES for a fixed preconditioner, one application "
+          "fewer per cycle; with single-precision factors as the preconditioner it keeps double-precision "
+          "convergence where plain GMRES loses it",
+          "[la][krylov][quick]") {
+  // 1D convection–diffusion, -u'' + 20 u' on 400 cells (upwind), as above
+  const Index n = 400;
+  const Real h = 1.0 / Real(n + 1), c = 20;
+  std::vector<Eigen::Triplet<Real>> t;
+  for (Index i = 0; i < n; ++i) {
+    t.emplace_back(i, i, 2 / (h * h) + c / h);
+    if (i > 0) t.emplace_back(i, i - 1, -1 / (h * h) - c / h);
+    if (i + 1 < n) t.emplace_back(i, i + 1, -1 / (h * h));
+  }
+  SparseMatrix A(n, n);
+  A.setFromTriplets(t.begin(), t.end());
+  const VecX b = VecX::LinSpaced(n, 1, 2), inv_diag = A.diagonal().cwiseInverse();
+  int applications = 0;
+  auto jacobi = [&](const VecX& v) {
+    ++applications;
+    return VecX(inv_diag.cwiseProduct(v));
+  };
+  // a fixed linear preconditioner: in one cycle the same Krylov space, so the same iterate and
+  // steps; plain GMRES applies P^-1 once more per cycle (to V y), flexible GMRES never
+  for (int restart : {1000, 25}) {
+    VecX xp, xf;
+    GmresWork wp, wf;
+    applications = 0;
+    const GmresResult rp = gmres(A, b, jacobi, {.tolerance = 1e-10, .max_iterations = 5000, .restart = restart}, xp, wp);
+    const int plain_applications = applications;
+    applications = 0;
+    const GmresResult rf = gmres(A, b, jacobi,
+                                 {.tolerance = 1e-10, .max_iterations = 5000, .restart = restart, .flexible = true}, xf, wf);
+    INFO("restart " << restart << ": plain " << rp.iterations << " steps, " << plain_applications
+                    << " applications; flexible " << rf.iterations << " steps, " << applications << " applications");
+    REQUIRE(rp.converged);
+    REQUIRE(rf.converged);
+    CHECK((b - A * xf).norm() <= 1e-10 * b.norm());
+    CHECK(applications == rf.iterations);
+    const int cycles = (rp.iterations + restart - 1) / restart;
+    CHECK(plain_applications == rp.iterations + cycles);
+    if (restart >= n) {  // one cycle (restarts let rounding steer the two apart)
+      CHECK(rf.iterations == rp.iterations);
+      CHECK((xf - xp).norm() <= 1e-10 * xp.norm());
+    }
+  }
+  // single-precision LU factors: P^-1 = A^-1 up to float rounding, which is not one linear map.
+  // To 1e-11 (the double-precision LU's own residual is 7e-13 here): plain GMRES puts the
+  // rounding of its last application back into each cycle's iterate; flexible GMRES gains at
+  // least what iterative refinement with these factors would, a factor delta = ||v - A P^-1 v||
+  // / ||v|| per application
+  using SpF = Eigen::SparseMatrix<float, Eigen::ColMajor, Index>;
+  Eigen::SparseLU<SpF> luf(A.cast<float>());
+  REQUIRE(luf.info() == Eigen::Success);
+  auto single = [&](const VecX& v) {
+    ++applications;
+    return VecX(luf.solve(v.cast<float>()).cast<Real>());
+  };
+  const Real tolerance = 1e-11, delta = (b - A * single(b)).norm() / b.norm();
+  REQUIRE(delta < 1e-2);
+  const int refinement_steps = int(std::ceil(std::log(tolerance) / std::log(delta)));
+  VecX xp, xf;
+  GmresWork wp, wf;
+  applications = 0;
+  const GmresResult rp = gmres(A, b, single, {.tolerance = tolerance, .max_iterations = 100, .restart = 100}, xp, wp);
+  const int plain_applications = applications;
+  applications = 0;
+  const GmresResult rf =
+      gmres(A, b, single, {.tolerance = tolerance, .max_iterations = 100, .restart = 100, .flexible = true}, xf, wf);
+  INFO("single-precision factors (delta " << delta << ") to " << tolerance << ": plain " << plain_applications
+                                          << " applications in " << rp.iterations << " steps, flexible "
+                                          << applications << "; refinement would need " << refinement_steps);
+  REQUIRE(rp.converged);
+  REQUIRE(rf.converged);
+  CHECK((b - A * xf).norm() <= tolerance * b.norm());
+  CHECK(applications <= refinement_steps);
+  CHECK(applications < plain_applications);
+}
+
 namespace {
 
 // SaddlePointGmres without `set_pressure_null_space`: a flow pins pressure DOF 0 for it, as it

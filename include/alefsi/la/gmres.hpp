@@ -15,6 +15,14 @@
 /// (it did for a free sphere on a graded mesh, docs/solvers.md); the corrections keep them. Cost:
 /// 2k more vectors, k products with A per cycle, no more preconditioner applications.
 ///
+/// With `flexible = true` it is FGMRES (Saad, SIAM J. Sci. Comput. 14 (1993) 461; Algorithm 9.6
+/// of the book): each preconditioned direction z_k = P^-1 v_k is kept and the iterate is formed
+/// as x = Z y. The plain form's x = P^-1 (V y) assumes that P^-1 is the same linear map at
+/// every application; a preconditioner that is not (single-precision factors, an inner
+/// iteration) then loses what its rounding or its variation adds, cycle after cycle. Flexible
+/// GMRES minimises the true residual over the directions it applied, whatever they were, and
+/// saves the one extra application per cycle. Cost: `restart` more vectors.
+///
 ///     GmresWork work;
 ///     GmresResult res = gmres(A, b, [&](const VecX& v) { return lu.solve(v); }, {.tolerance = 1e-12}, x, work);
 #include <algorithm>
@@ -31,18 +39,19 @@ struct GmresOptions {
   int max_iterations = 1000;  ///< applications of A (and of the preconditioner)
   int restart = 60;           ///< Krylov vectors per cycle (memory: restart + 1 vectors)
   int augment = 0;            ///< LGMRES: earlier cycle corrections kept (memory: 2 augment vectors more)
+  bool flexible = false;      ///< FGMRES: keep z_k = P^-1 v_k, x = Z y (memory: restart vectors more)
 };
 
 struct GmresResult {
-  int iterations = 0;     ///< applications of the preconditioner (Krylov steps)
+  int iterations = 0;     ///< Krylov steps (P^-1 applied once per step, once more per cycle unless flexible)
   Real residual = 0;      ///< ||b - A x|| / ||b|| at the end (0 for b = 0)
   bool converged = false;
 };
 
-/// The Krylov basis and the LGMRES corrections, kept between calls so that repeated solves do
-/// not reallocate them.
+/// The Krylov basis, the LGMRES corrections and FGMRES's preconditioned directions, kept
+/// between calls so that repeated solves do not reallocate them.
 struct GmresWork {
-  MatX V, Z;
+  MatX V, Z, F;
 };
 
 /// x = the GMRES iterate for A x = b (A: any matrix with A * VecX, e.g. SparseMatrix),
@@ -65,6 +74,8 @@ GmresResult gmres(const Matrix& A, const VecX& b, Precondition&& precondition, c
   // grown, never shrunk: callers alternate between restart lengths (LinearSolve's coupled solves)
   if (V.cols() < m + k_aug + 1 || V.rows() != n) V.resize(n, m + k_aug + 1);
   if (Z.cols() < k_aug || Z.rows() != n) Z.resize(n, k_aug);
+  MatX& F = work.F;  // flexible: F.col(k) = P^-1 V.col(k) as applied
+  if (opt.flexible && (F.cols() < m || F.rows() != n)) F.resize(n, m);
   int n_z = 0;  // corrections stored so far (< k_aug in the first cycles)
   MatX H = MatX::Zero(m + k_aug + 1, m + k_aug);
   VecX g(m + k_aug + 1), cs(m + k_aug), sn(m + k_aug), w(n);
@@ -107,7 +118,12 @@ GmresResult gmres(const Matrix& A, const VecX& b, Precondition&& precondition, c
     };
     bool done = false;
     while (!done && k < m && res.iterations < opt.max_iterations) {
-      w.noalias() = A * precondition(VecX(V.col(k)));
+      if (opt.flexible) {
+        F.col(k) = precondition(VecX(V.col(k)));
+        w.noalias() = A * F.col(k);
+      } else {
+        w.noalias() = A * precondition(VecX(V.col(k)));
+      }
       ++res.iterations;
       done = arnoldi(false);
     }
@@ -121,7 +137,8 @@ GmresResult gmres(const Matrix& A, const VecX& b, Precondition&& precondition, c
         if (k > k0) used.push_back(j);
       }
     const VecX y = H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
-    VecX dx = precondition(VecX(V.leftCols(n_krylov) * y.head(n_krylov)));
+    VecX dx = opt.flexible ? VecX(F.leftCols(n_krylov) * y.head(n_krylov))
+                           : VecX(precondition(VecX(V.leftCols(n_krylov) * y.head(n_krylov))));
     for (std::size_t j = 0; j < used.size(); ++j) dx.noalias() += y[n_krylov + Index(j)] * Z.col(used[j]);
     x += dx;
     if (k_aug > 0) {  // newest correction first, the oldest dropped

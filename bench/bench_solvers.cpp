@@ -174,9 +174,10 @@ Real relative_residual(const SparseMatrix& A, const VecX& x, const VecX& b) {
 }
 
 // Factors in double and in single precision as right preconditioners to 1e-13 (the
-// factorisation reuse's tolerance), by la/gmres.hpp's GMRES, plain and flexible: on the factorised matrix itself and on a later matrix of the same pattern, each entry
-// moved by an independent random relative amount in [-1e-3, 1e-3]. Prints the times and the
-// applications of P^-1 (a GMRES cycle applies it once more than its iterations).
+// factorisation reuse's tolerance), by la/gmres.hpp's GMRES, plain and flexible: on the
+// factorised matrix itself and on a later matrix of the same pattern, each entry moved by an
+// independent random relative amount in [-1e-3, 1e-3]. Prints the times and the applications
+// of P^-1 (a plain GMRES cycle applies it once more than its steps).
 template <class Pair>
 void precision_study(const std::string& pair, int n, double mass, int repeat, double pivot_threshold) {
   const LinearSystem s = stokes_system<Pair>(n, mass);

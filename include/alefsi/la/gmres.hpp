@@ -2,10 +2,10 @@
 /// \file la/gmres.hpp
 /// Restarted GMRES(m) with right preconditioning (Saad & Schultz 1986; Saad, Iterative Methods
 /// for Sparse Linear Systems, 2nd ed., Algorithm 9.5), the one Krylov loop of the library: it
-/// solves A P^-1 y = b, x = P^-1 y, from x = 0, with modified Gram–Schmidt Arnoldi and Givens
-/// rotations, and stops when the true residual ||b - A x||_2 <= tolerance ||b||_2 (checked at
-/// each restart; within a cycle the rotated residual decides) or after max_iterations
-/// applications of the preconditioner. It does not throw: the caller decides what a miss means
+/// solves A P^-1 y = b, x = P^-1 y (or flexibly, below), from x = 0, with modified Gram–Schmidt
+/// Arnoldi and Givens rotations, and stops when the true residual ||b - A x||_2 <= tolerance
+/// ||b||_2 (checked at each restart; within a cycle the rotated residual decides) or after
+/// max_iterations Krylov steps. It does not throw: the caller decides what a miss means
 /// (`SaddlePointGmres` throws SolverError; `LinearSolve` refactorises, sim/newton.hpp).
 ///
 /// With `augment = k > 0` it is LGMRES(m, k) (Baker, Jessup & Manteuffel, SIAM J. Matrix Anal.
@@ -36,7 +36,7 @@ namespace alefsi {
 
 struct GmresOptions {
   Real tolerance = 1e-8;      ///< on ||b - A x||_2 / ||b||_2
-  int max_iterations = 1000;  ///< applications of A (and of the preconditioner)
+  int max_iterations = 1000;  ///< Krylov steps (each one application of P^-1 and of A)
   int restart = 60;           ///< Krylov vectors per cycle (memory: restart + 1 vectors)
   int augment = 0;            ///< LGMRES: earlier cycle corrections kept (memory: 2 augment vectors more)
   bool flexible = false;      ///< FGMRES: keep z_k = P^-1 v_k, x = Z y (memory: restart vectors more)

@@ -687,13 +687,11 @@ TEST_CASE("AleFlow with SaddlePointGmres: a 3D Navier–Stokes step with a free 
   CHECK((krylov.body_velocity(0) - direct.body_velocity(0)).norm() <= 1e-7 * direct.body_velocity(0).norm());
 }
 
-TEST_CASE("gmres with augment (LGMRES): the corrections keep what a short restart loses; the answer is the "
-          "direct one",
-          "[la][krylov][quick]") {
-  // 1D convection–diffusion, -u'' + 20 u' on 400 cells (upwind), Jacobi-preconditioned: a
-  // nonsymmetric matrix on which GMRES(10) needs many cycles
-  const Index n = 400;
-  const Real h = 1.0 / Real(n + 1), c = 20;
+namespace {
+// 1D convection–diffusion, -u'' + c u' on n interior nodes of (0, 1) (upwind differences): a
+// nonsymmetric matrix on which Jacobi-preconditioned GMRES(10) needs many cycles
+SparseMatrix convection_diffusion_1d(Index n, Real c) {
+  const Real h = 1.0 / Real(n + 1);
   std::vector<Eigen::Triplet<Real>> t;
   for (Index i = 0; i < n; ++i) {
     t.emplace_back(i, i, 2 / (h * h) + c / h);
@@ -702,6 +700,15 @@ TEST_CASE("gmres with augment (LGMRES): the corrections keep what a short restar
   }
   SparseMatrix A(n, n);
   A.setFromTriplets(t.begin(), t.end());
+  return A;
+}
+}  // namespace
+
+TEST_CASE("gmres with augment (LGMRES): the corrections keep what a short restart loses; the answer is the "
+          "direct one",
+          "[la][krylov][quick]") {
+  const Index n = 400;
+  const SparseMatrix A = convection_diffusion_1d(n, 20);
   const VecX b = VecX::Ones(n), inv_diag = A.diagonal().cwiseInverse();
   auto jacobi = [&](const VecX& v) { return VecX(inv_diag.cwiseProduct(v)); };
   Eigen::SparseLU<SparseMatrix> lu(A);
@@ -734,17 +741,8 @@ TEST_CASE("gmres with flexible (FGMRES): the iterate of plain GMRES for a fixed 
           "fewer per cycle; with single-precision factors as the preconditioner it keeps double-precision "
           "convergence where plain GMRES loses it",
           "[la][krylov][quick]") {
-  // 1D convection–diffusion, -u'' + 20 u' on 400 cells (upwind), as above
   const Index n = 400;
-  const Real h = 1.0 / Real(n + 1), c = 20;
-  std::vector<Eigen::Triplet<Real>> t;
-  for (Index i = 0; i < n; ++i) {
-    t.emplace_back(i, i, 2 / (h * h) + c / h);
-    if (i > 0) t.emplace_back(i, i - 1, -1 / (h * h) - c / h);
-    if (i + 1 < n) t.emplace_back(i, i + 1, -1 / (h * h));
-  }
-  SparseMatrix A(n, n);
-  A.setFromTriplets(t.begin(), t.end());
+  const SparseMatrix A = convection_diffusion_1d(n, 20);
   const VecX b = VecX::LinSpaced(n, 1, 2), inv_diag = A.diagonal().cwiseInverse();
   int applications = 0;
   auto jacobi = [&](const VecX& v) {

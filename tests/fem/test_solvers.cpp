@@ -269,6 +269,25 @@ TEST_CASE("UMFPACK strategies agree; a singular matrix throws", "[la][solvers][s
   lu2.analyze(singular);
   CHECK_THROWS_AS(lu2.factorize(singular), SolverError);
 }
+
+TEST_CASE("UMFPACK keeps its own copy of the factorised matrix; another pattern is analysed again; move-only",
+          "[la][solvers][suitesparse][quick]") {
+  const auto s10 = stokes_system<TaylorHood>(10), s12 = stokes_system<TaylorHood>(12);
+  UmfPackLu lu;
+  {
+    SparseMatrix A = s10.A;  // factorised, then changed and destroyed before the solve
+    lu.factorize(A);
+    A *= 2;
+  }
+  const VecX x = lu.solve(s10.b);  // iterative refinement multiplies by the copy, not the dead matrix
+  CHECK(relative_residual(s10.A, x, s10.b) < 1e-12);
+  lu.factorize(s12.A);  // a larger system, no analyze: analysed again
+  CHECK(relative_residual(s12.A, lu.solve(s12.b), s12.b) < 1e-12);
+  UmfPackLu moved = std::move(lu);
+  CHECK(relative_residual(s12.A, moved.solve(s12.b), s12.b) < 1e-12);
+  CHECK_THROWS_AS(moved.solve(s10.b), SolverError);  // wrong size: named, not read out of bounds
+  CHECK_THROWS_AS(UmfPackLu().solve(s10.b), SolverError);  // before any factorisation
+}
 #endif
 
 TEMPLATE_LIST_TEST_CASE("one analysis serves several factorisations of the same pattern", "[la][solvers][quick]",

@@ -53,7 +53,7 @@
 /// hierarchies and Schur approximations (values are read: per matrix); `solve(b)` iterates until
 /// ||b - K x|| <= tolerance ||b|| and throws `SolverError` when `max_iterations` are spent.
 /// Lifetime: `solve` multiplies by the matrix given to `factorize`, which must stay alive and
-/// unchanged until the last `solve` (as for UmfPackLu).
+/// unchanged until the last `solve` (UmfPackLu keeps a copy instead; this solver does not).
 /// `set_coupling(C)` (la/coupling.hpp): entries among the extra unknowns that A's pattern lacks
 /// (two bodies in contact); the solves are then with A + C, and the set-up's exact elimination
 /// of the extra unknowns includes C (the values it had at the set-up).

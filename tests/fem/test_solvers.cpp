@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <string>
 #include <tuple>
@@ -823,6 +824,44 @@ TEST_CASE("gmres with flexible (FGMRES): the iterate of plain GMRES for a fixed 
   REQUIRE(rf.converged);
   CHECK((b - A * xf).norm() <= tolerance * b.norm());
   CHECK(applications < plain_applications);
+}
+
+TEST_CASE("gmres breakdown: a preconditioner that returns zero or NaN, or is singular on the Krylov space, ends "
+          "the solve at the best iterate it allows, finite, without spinning to max_iterations",
+          "[la][krylov][quick]") {
+  SparseMatrix I(4, 4);
+  I.setIdentity();
+  const VecX b = VecX::Ones(4);
+  for (bool flexible : {false, true}) {
+    CAPTURE(flexible);
+    const GmresOptions opt{.tolerance = 1e-10, .max_iterations = 100, .restart = 10, .flexible = flexible};
+    VecX x;
+    GmresWork work;
+    // P^-1 = 0 and P^-1 = NaN: no direction at all; x stays 0
+    for (Real value : {Real(0), std::numeric_limits<Real>::quiet_NaN()}) {
+      CAPTURE(value);
+      const GmresResult res = gmres(I, b, [&](const VecX& v) { return VecX(VecX::Constant(v.size(), value)); }, opt, x, work);
+      CHECK(res.breakdown);
+      CHECK_FALSE(res.converged);
+      CHECK(res.iterations == 1);
+      CHECK(res.residual == 1);
+      CHECK(x == VecX::Zero(4));
+    }
+    // P^-1 = the projection on the first two unknowns: A x = b is solvable only there. The
+    // first cycle's second step, P^-1 v_1 = P^-1 v_0, adds nothing (exactly, in these binary
+    // fractions); the cycle ends with x = (1, 1, 0, 0), the least-squares optimum over range(P^-1),
+    // residual 1 / sqrt(2); the next cycle's first step is zero and ends the solve: 3 steps in
+    // exact arithmetic. (Plain GMRES's x = P^-1 (V y) may leave a residual of round-off size on
+    // the first two unknowns, which costs one more cycle of two steps.)
+    const GmresResult res = gmres(
+        I, b, [](const VecX& v) { return VecX((VecX(4) << v[0], v[1], 0, 0).finished()); }, opt, x, work);
+    CHECK(res.breakdown);
+    CHECK_FALSE(res.converged);
+    CHECK(res.iterations >= 3);
+    CHECK(res.iterations <= 5);
+    CHECK(std::abs(res.residual - 1 / std::sqrt(Real(2))) <= 1e-15);
+    CHECK((x - VecX((VecX(4) << 1, 1, 0, 0).finished())).norm() <= 1e-15);
+  }
 }
 
 namespace {

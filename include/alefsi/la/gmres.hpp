@@ -8,6 +8,13 @@
 /// max_iterations Krylov steps. It does not throw: the caller decides what a miss means
 /// (`SaddlePointGmres` throws SolverError; `LinearSolve` refactorises, sim/newton.hpp).
 ///
+/// Breakdown: a step whose A P^-1 v_k adds no new direction to the residual's least-squares
+/// problem (the new column of its triangular factor is below round-off, 0 or not finite: a
+/// preconditioner that returns zero or NaN, or one singular on the Krylov space) is dropped and
+/// ends the cycle, which then updates x from the steps before it; a cycle that breaks down at
+/// its first step ends the solve, not converged, with `breakdown` set and x the previous
+/// cycles' iterate (it does not spin to max_iterations, and no rotation divides by zero).
+///
 /// With `augment = k > 0` it is LGMRES(m, k) (Baker, Jessup & Manteuffel, SIAM J. Matrix Anal.
 /// Appl. 26 (2005) 962): each cycle's search space is the m Krylov directions plus the k latest
 /// cycle corrections z_j = x_j - x_{j-1}. A restart otherwise forgets the slow error components
@@ -27,6 +34,7 @@
 ///     GmresResult res = gmres(A, b, [&](const VecX& v) { return lu.solve(v); }, {.tolerance = 1e-12}, x, work);
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "alefsi/core/eigen_sparse.hpp"
@@ -46,6 +54,7 @@ struct GmresResult {
   int iterations = 0;     ///< Krylov steps (P^-1 applied once per step, once more per cycle unless flexible)
   Real residual = 0;      ///< ||b - A x|| / ||b|| at the end (0 for b = 0)
   bool converged = false;
+  bool breakdown = false;  ///< a cycle could not take its first step (see the file comment)
 };
 
 /// The Krylov basis, the LGMRES corrections and FGMRES's preconditioned directions, kept
@@ -87,6 +96,7 @@ GmresResult gmres(const Matrix& A, const VecX& b, Precondition&& precondition, c
     g[0] = rnorm;
     H.setZero();
     int k = 0;
+    bool broke = false;  // this cycle's latest Krylov step added nothing: the cycle ends
     // one Arnoldi step on the new direction w = A q (q: P^-1 v_k or a stored correction);
     // `optional`: a correction (nearly) in the space already is left out, not added
     auto arnoldi = [&](bool optional) {
@@ -107,6 +117,11 @@ GmresResult gmres(const Matrix& A, const VecX& b, Precondition&& precondition, c
         H(i, k) = t;
       }
       const Real h = std::hypot(H(k, k), H(k + 1, k));
+      if (!(h > std::numeric_limits<Real>::epsilon() * wnorm)) {  // breakdown (also h or wnorm NaN)
+        H.col(k).setZero();
+        broke = !optional;
+        return false;
+      }
       cs[k] = H(k, k) / h;
       sn[k] = H(k + 1, k) / h;
       H(k, k) = h;
@@ -117,7 +132,7 @@ GmresResult gmres(const Matrix& A, const VecX& b, Precondition&& precondition, c
       return std::abs(g[k]) <= target;
     };
     bool done = false;
-    while (!done && k < m && res.iterations < opt.max_iterations) {
+    while (!done && !broke && k < m && res.iterations < opt.max_iterations) {
       if (opt.flexible) {
         F.col(k) = precondition(VecX(V.col(k)));
         w.noalias() = A * F.col(k);
@@ -128,6 +143,10 @@ GmresResult gmres(const Matrix& A, const VecX& b, Precondition&& precondition, c
       done = arnoldi(false);
     }
     const int n_krylov = k;
+    if (broke && n_krylov == 0) {
+      res.breakdown = true;
+      break;
+    }
     std::vector<int> used;  // the corrections added, in the order of their columns
     if (n_krylov == m)  // a full cycle: add the stored corrections to the search space
       for (int j = 0; j < n_z && !done; ++j) {

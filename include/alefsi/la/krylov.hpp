@@ -286,7 +286,8 @@ class SaddlePointGmres {
     if (!res.converged)
       throw SolverError(std::string(name) + " did not converge: " + std::to_string(res.iterations) +
                         " iterations, relative residual " + detail::sci(res.residual) + " (tolerance " +
-                        detail::sci(opt_.tolerance) + ")");
+                        detail::sci(opt_.tolerance) + ")" +
+                        (res.breakdown ? "; breakdown: the preconditioned operator gave no new direction" : ""));
     return x;
   }
 

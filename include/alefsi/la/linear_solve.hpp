@@ -173,7 +173,7 @@ class LinearSolve {
     } else {
       VecX x;
       const GmresResult res = gmres(
-          J, r, [this](const VecX& v) { return VecX(solver_.solve(v)); },
+          J, r, [&](const VecX& v) { return apply_kept(J, v); },
           {.tolerance = reuse_.tolerance, .max_iterations = reuse_.max_iterations, .restart = reuse_.max_iterations},
           x, work_);
       counts.krylov_iterations += res.iterations;
@@ -191,7 +191,7 @@ class LinearSolve {
     const BlockCoupling& C = *coupling_;
     auto run = [&](int cap, VecX& x) {
       const GmresResult res = gmres(
-          CoupledMatrix<SparseMatrix>{J, C}, r, [this](const VecX& v) { return VecX(solver_.solve(v)); },
+          CoupledMatrix<SparseMatrix>{J, C}, r, [&](const VecX& v) { return apply_kept(J, v); },
           {.tolerance = reuse_.tolerance, .max_iterations = cap, .restart = cap}, x, work_);
       counts.krylov_iterations += res.iterations;
       return res;
@@ -210,6 +210,14 @@ class LinearSolve {
     fresh_ = false;
     run(m + 4, x);
     return x;
+  }
+  // the kept factors applied to v as GMRES's preconditioner for J; a solver that refines its
+  // solves (UmfPackLu) refines against J, the matrix being solved, not the one it factorised
+  VecX apply_kept(const SparseMatrix& J, const VecX& v) {
+    if constexpr (requires { solver_.solve_refined_against(J, v); })
+      return solver_.solve_refined_against(J, v);
+    else
+      return solver_.solve(v);
   }
   static VecX values(const SparseMatrix& J) { return Eigen::Map<const VecX>(J.valuePtr(), J.nonZeros()); }
 

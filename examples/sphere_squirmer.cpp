@@ -80,8 +80,8 @@ using std::numbers::pi;
 // DefaultDirectSolver: UMFPACK (symmetric strategy) when alefsi was built with SuiteSparse, else
 // SparseLu<>. UMFPACK was the fastest of UMFPACK symmetric / automatic / unsymmetric and
 // SparseLu<> on the 40k-unknown mesh (10 / 10 / 20 / 27 s CPU), SparseLu the leanest (0.9 GB
-// against 1.5 GB); UMFPACK's 32-bit version (Eigen's wrapper) stops with "out of memory" near
-// 9e4 unknowns (docs/results.md).
+// against 1.5 GB). UmfPackLu calls UMFPACK's 64-bit interface: the 32-bit one (Eigen's
+// wrapper) stopped with "out of memory" near 9e4 unknowns (docs/results.md).
 #ifdef ALEFSI_SQUIRMER_PETSC
 using Solver = PetscDirect;
 #else

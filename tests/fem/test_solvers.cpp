@@ -288,6 +288,7 @@ TEST_CASE("UMFPACK keeps its own copy of the factorised matrix; another pattern 
   CHECK(relative_residual(s12.A, moved.solve(s12.b), s12.b) < 1e-12);
   CHECK_THROWS_AS(moved.solve(s10.b), SolverError);  // wrong size: named, not read out of bounds
   CHECK_THROWS_AS(UmfPackLu().solve(s10.b), SolverError);  // before any factorisation
+  CHECK_THROWS_WITH(UmfPackLu().factorize(SparseMatrix(3, 4)), Catch::Contains("not square"));
   // a later matrix of the same pattern (velocity diagonal +0.1 %): the factors of s12.A alone
   // leave a residual of the size of the change; refined against the later matrix, UMFPACK's
   // iterative refinement (at most 2 steps, each contracting by about the change) takes it down

@@ -122,15 +122,10 @@ class UmfPackLu {
     factor_nonzeros_ = Index(info_[UMFPACK_LNZ] + info_[UMFPACK_UNZ]);
   }
   VecX solve(const VecX& b) {
-    if (!numeric_) throw SolverError("UMFPACK solve before a successful factorize");
-    if (b.size() != n_)
+    if (numeric_ && b.size() != n_)
       throw SolverError("UMFPACK solve: right-hand side of size " + std::to_string(b.size()) + " for a matrix of " +
                         std::to_string(n_) + " rows");
-    VecX x(n_);
-    const Long status = umfpack_dl_solve(UMFPACK_A, ap_.data(), ai_.data(), ax_.data(), x.data(), b.data(), numeric_,
-                                         control_.data(), info_.data());
-    if (status != UMFPACK_OK) throw SolverError("UMFPACK solve failed: " + message(status));
-    return x;
+    return refined_solve(ax_.data(), b);
   }
   /// The factors at hand applied to b, with UMFPACK's iterative refinement against A instead of
   /// the factorised matrix: A is a later matrix of the analysed pattern (Newton iterations,
@@ -138,17 +133,12 @@ class UmfPackLu {
   /// `LinearSolve` preconditions its GMRES on a reused factorisation with it (la/linear_solve.hpp;
   /// docs/solvers.md, "UMFPACK's index width": 1.6x fewer CPU seconds on the annulus).
   VecX solve_refined_against(const SparseMatrix& A, const VecX& b) {
-    if (!numeric_) throw SolverError("UMFPACK solve before a successful factorize");
-    if (A.rows() != n_ || A.cols() != n_ || Long(A.nonZeros()) != Long(ai_.size()) || b.size() != n_)
+    if (numeric_ && (A.rows() != n_ || A.cols() != n_ || Long(A.nonZeros()) != Long(ai_.size()) || b.size() != n_))
       throw SolverError("UMFPACK refinement: a matrix of " + std::to_string(A.rows()) + " rows and " +
                         std::to_string(A.nonZeros()) + " entries and a right-hand side of " +
                         std::to_string(b.size()) + " for factors of " + std::to_string(n_) + " rows and " +
                         std::to_string(ai_.size()) + " entries");
-    VecX x(n_);
-    const Long status = umfpack_dl_solve(UMFPACK_A, ap_.data(), ai_.data(), A.valuePtr(), x.data(), b.data(),
-                                         numeric_, control_.data(), info_.data());
-    if (status != UMFPACK_OK) throw SolverError("UMFPACK solve failed: " + message(status));
-    return x;
+    return refined_solve(A.valuePtr(), b);
   }
   /// Entries in L (without its unit diagonal) and U, from the last factorisation.
   Index factor_nonzeros() const { return factor_nonzeros_; }
@@ -160,6 +150,16 @@ class UmfPackLu {
     if (status == UMFPACK_ERROR_invalid_matrix) return "invalid matrix (unsorted or duplicate row indices)";
     if (status == UMFPACK_ERROR_n_nonpositive) return "empty matrix";
     return "UMFPACK status " + std::to_string(status);
+  }
+  // the factors applied to b (sizes checked by the caller), refined against the matrix of the
+  // analysed pattern with these values
+  VecX refined_solve(const Real* values, const VecX& b) {
+    if (!numeric_) throw SolverError("UMFPACK solve before a successful factorize");
+    VecX x(n_);
+    const Long status = umfpack_dl_solve(UMFPACK_A, ap_.data(), ai_.data(), values, x.data(), b.data(), numeric_,
+                                         control_.data(), info_.data());
+    if (status != UMFPACK_OK) throw SolverError("UMFPACK solve failed: " + message(status));
+    return x;
   }
   // the matrix in UMFPACK's compressed-column form with 64-bit indices (A: column-major)
   void copy(const SparseMatrix& A) {
